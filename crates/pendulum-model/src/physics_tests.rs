@@ -1,0 +1,295 @@
+//! The simulator against independent references: conservation, analytic decays, a second run at
+//! tighter tolerance, a plain RK4 at a tiny step.
+
+use std::ops::ControlFlow;
+
+use crate::sim::{integrate, rk4_fixed, simulate, uniform_times, Model, SimOptions};
+use crate::{Dimensionless, Excitation};
+
+fn free(beta: f64, m_coulomb: f64, c: f64) -> Model {
+    let mut d = Dimensionless::conservative();
+    d.beta = beta;
+    d.m_coulomb = m_coulomb;
+    d.c = c;
+    Model::with_excitation(d, Excitation::None)
+}
+
+/// Turning points (|θ| at θ̇ sign changes), refined by a parabola through three samples.
+fn turning_points(theta: &[f64], theta_dot: &[f64]) -> Vec<f64> {
+    let mut out = Vec::new();
+    for i in 1..theta.len() - 1 {
+        let (a, b, c) = (theta[i - 1], theta[i], theta[i + 1]);
+        let is_max = b > a && b >= c;
+        let is_min = b < a && b <= c;
+        if (is_max || is_min) && theta_dot[i] != 0.0 {
+            let denom = a - 2.0 * b + c;
+            let peak = if denom != 0.0 {
+                b - 0.125 * (c - a) * (c - a) / denom
+            } else {
+                b
+            };
+            out.push(peak.abs());
+        }
+    }
+    out
+}
+
+#[test]
+fn energy_conserved_over_100_swings() {
+    let m = free(0.0, 0.0, 0.0);
+    let opts = SimOptions::with_tol(1e-12);
+    // Amplitude 1 rad: period ≈ 6.70, so 100 swings ≈ 670 time units.
+    let tr = simulate(&m, &opts, [1.0, 0.0], 0.0, 680.0, 0.05).unwrap();
+    let e0 = m.energy(1.0, 0.0);
+    let worst = tr
+        .theta
+        .iter()
+        .zip(&tr.theta_dot)
+        .map(|(&a, &w)| (m.energy(a, w) - e0).abs())
+        .fold(0.0, f64::max);
+    assert!(worst < 1e-8, "energy drift {worst}");
+    let swings = turning_points(&tr.theta, &tr.theta_dot).len() / 2;
+    assert!(swings >= 100, "{swings} swings");
+}
+
+/// Constant dry torque c: from rest at −A the pendulum next rests at B with
+/// −cos B + cos A = −c (A + B) (the work of friction), exactly, for any amplitude.
+#[test]
+fn constant_coulomb_decay_follows_work_energy_law() {
+    let c = 0.01;
+    let m = free(0.0, 0.0, c);
+    let opts = SimOptions::with_tol(1e-11);
+    let tr = simulate(&m, &opts, [0.8, 0.0], 0.0, 400.0, 0.002).unwrap();
+    let mut amps = vec![0.8];
+    amps.extend(turning_points(&tr.theta, &tr.theta_dot));
+    assert!(amps.len() > 20, "only {} turning points", amps.len());
+    for w in amps.windows(2) {
+        let a = w[0];
+        // Newton on g(B) = cos B − cos A − c(A + B).
+        let mut b = a - 2.0 * c;
+        for _ in 0..50 {
+            let g = b.cos() - a.cos() - c * (a + b);
+            let dg = -b.sin() - c;
+            b -= g / dg;
+        }
+        assert!((w[1] - b).abs() < 2e-7, "A={a}: next {} vs exact {b}", w[1]);
+        if a < 0.1 {
+            // Small swings lose 2c per half swing: linear decay.
+            assert!(
+                ((a - w[1]) - 2.0 * c).abs() < 2e-4,
+                "decrement {}",
+                a - w[1]
+            );
+        }
+    }
+    // It ends stuck, exactly at rest, where gravity cannot beat the dry torque.
+    assert!(tr.stats.ended_stuck);
+    let (th, w) = (*tr.theta.last().unwrap(), *tr.theta_dot.last().unwrap());
+    assert_eq!(w, 0.0);
+    assert!(th.sin().abs() <= c + 1e-12, "rest at {th}");
+}
+
+/// Bearing friction M|θ̇² + cos θ|: at small amplitude the loss per half swing is ≈ 2M, constant
+/// (linear decay) — unlike viscous damping, whose decrement shrinks with the amplitude.
+#[test]
+fn bearing_coulomb_decay_is_linear() {
+    let mc = 0.0073;
+    let m = free(0.0, mc, 0.0);
+    let tr = simulate(
+        &m,
+        &SimOptions::with_tol(1e-11),
+        [0.1, 0.0],
+        0.0,
+        200.0,
+        0.002,
+    )
+    .unwrap();
+    let mut amps = vec![0.1];
+    amps.extend(turning_points(&tr.theta, &tr.theta_dot));
+    let dec: Vec<f64> = amps.windows(2).map(|w| w[0] - w[1]).collect();
+    assert!(dec.len() >= 5);
+    for d in &dec {
+        // Exact small-amplitude value 2M(1 + O(A²)); A ≤ 0.1 keeps the correction under 1 %.
+        assert!(
+            (d / (2.0 * mc) - 1.0).abs() < 0.01,
+            "decrement {d} vs {}",
+            2.0 * mc
+        );
+    }
+    assert!(tr.stats.ended_stuck);
+    assert_eq!(*tr.theta_dot.last().unwrap(), 0.0);
+}
+
+/// θ̈ + β θ̇ + θ = 0 (small swings): logarithmic decrement per period 2πζ/sqrt(1 − ζ²), ζ = β/2.
+#[test]
+fn viscous_decay_has_the_logarithmic_decrement() {
+    let beta = 0.05;
+    let m = free(beta, 0.0, 0.0);
+    let a0 = 0.001; // sin θ ≈ θ to 2e-7 relative
+    let tr = simulate(
+        &m,
+        &SimOptions::with_tol(1e-12),
+        [a0, 0.0],
+        0.0,
+        60.0,
+        0.001,
+    )
+    .unwrap();
+    // Maxima only (every other turning point).
+    let peaks: Vec<f64> = (1..tr.theta.len() - 1)
+        .filter(|&i| tr.theta[i] > tr.theta[i - 1] && tr.theta[i] >= tr.theta[i + 1])
+        .map(|i| {
+            let (a, b, c) = (tr.theta[i - 1], tr.theta[i], tr.theta[i + 1]);
+            b - 0.125 * (c - a) * (c - a) / (a - 2.0 * b + c)
+        })
+        .collect();
+    assert!(peaks.len() >= 5);
+    let zeta = beta / 2.0;
+    let delta = 2.0 * std::f64::consts::PI * zeta / (1.0 - zeta * zeta).sqrt();
+    for w in peaks.windows(2) {
+        let d = (w[0] / w[1]).ln();
+        assert!((d / delta - 1.0).abs() < 1e-4, "decrement {d} vs {delta}");
+    }
+}
+
+fn forced_reference() -> Model {
+    let mut d = Dimensionless::conservative();
+    d.omega = 1.2;
+    d.r = 0.3;
+    d.lambda = 0.126;
+    d.beta = 0.08;
+    d.m_coulomb = 0.0073;
+    d.alpha = 0.01;
+    Model::new(d)
+}
+
+#[test]
+fn agrees_with_itself_at_100x_tighter_tolerance() {
+    for m in [forced_reference(), {
+        let mut m = forced_reference();
+        m.params.m_coulomb = 0.0;
+        m
+    }] {
+        let a = simulate(
+            &m,
+            &SimOptions::with_tol(1e-8),
+            [0.6, 0.0],
+            0.0,
+            100.0,
+            0.01,
+        )
+        .unwrap();
+        let b = simulate(
+            &m,
+            &SimOptions::with_tol(1e-10),
+            [0.6, 0.0],
+            0.0,
+            100.0,
+            0.01,
+        )
+        .unwrap();
+        let worst = a
+            .theta
+            .iter()
+            .zip(&b.theta)
+            .map(|(x, y)| (x - y).abs())
+            .fold(0.0, f64::max);
+        assert!(worst < 1e-6, "max |Δθ| = {worst}");
+        assert!(worst > 0.0, "identical runs prove nothing");
+    }
+}
+
+/// A second, independent integrator: classical RK4 at h = 1e-3 on a smooth forced case.
+#[test]
+fn agrees_with_fine_rk4() {
+    let mut m = forced_reference();
+    m.params.m_coulomb = 0.0;
+    for t_end in [5.0, 17.3, 40.0] {
+        let r = rk4_fixed(&m, [0.6, 0.2], 0.0, t_end, 1e-3);
+        let mut got = [0.0; 2];
+        integrate(
+            &m,
+            &SimOptions::with_tol(1e-11),
+            0.0,
+            [0.6, 0.2],
+            t_end,
+            [t_end],
+            |s| {
+                got = [s.theta, s.theta_dot];
+                ControlFlow::Continue(())
+            },
+        )
+        .unwrap();
+        assert!(
+            (got[0] - r[0]).abs() < 1e-8 && (got[1] - r[1]).abs() < 1e-8,
+            "{got:?} vs {r:?}"
+        );
+    }
+}
+
+#[test]
+fn resting_pendulum_stays_exactly_at_rest() {
+    // Starts at rest inside the friction cone, under forcing too weak to free it.
+    let mut m = forced_reference();
+    m.params.r = 0.001;
+    m.params.m_coulomb = 0.02;
+    let tr = simulate(&m, &SimOptions::default(), [0.005, 0.0], 0.0, 200.0, 0.05).unwrap();
+    assert!(tr.theta_dot.iter().all(|&w| w == 0.0));
+    assert!(tr.theta.iter().all(|&t| t == 0.005));
+    assert!(tr.stats.steps == 0 && tr.stats.ended_stuck);
+    // A decaying one comes to rest with θ̇ exactly 0 and stays there.
+    let m = free(0.02, 0.0073, 0.0);
+    let tr = simulate(&m, &SimOptions::default(), [1.0, 0.0], 0.0, 300.0, 0.05).unwrap();
+    let first_rest = tr.theta_dot.iter().rposition(|&w| w != 0.0).unwrap() + 1;
+    assert!(first_rest < tr.t.len() - 100);
+    assert!(tr.theta[first_rest..]
+        .iter()
+        .all(|&t| t == tr.theta[first_rest]));
+    assert!(
+        tr.stats.events < 200,
+        "{} events: chattering",
+        tr.stats.events
+    );
+}
+
+/// Stick/slip under forcing: while stuck θ̇ = 0 exactly and the static balance holds; the
+/// pendulum breaks loose again when the base acceleration makes |Q| exceed the capacity.
+#[test]
+fn forced_stick_slip_respects_the_friction_cone() {
+    let mut d = Dimensionless::conservative();
+    d.omega = 1.0;
+    d.r = 0.6;
+    d.lambda = 0.126;
+    d.m_coulomb = 0.05;
+    d.beta = 0.05;
+    let m = Model::new(d);
+    let mut stuck_samples = 0;
+    let mut slipping_after_stick = false;
+    let mut prev_stuck = false;
+    integrate(
+        &m,
+        &SimOptions::default(),
+        0.0,
+        [0.3, 0.0],
+        200.0,
+        uniform_times(0.0, 200.0, 0.01),
+        |s| {
+            // t = 0 is a release from rest, not a stick.
+            if s.theta_dot == 0.0 && s.t > 0.0 {
+                stuck_samples += 1;
+                let (q, c) = m.static_balance(s.t, s.theta);
+                assert!(q.abs() <= c + 1e-9, "stuck outside the cone at t={}", s.t);
+                prev_stuck = true;
+            } else {
+                if prev_stuck {
+                    slipping_after_stick = true;
+                }
+                prev_stuck = false;
+            }
+            ControlFlow::Continue(())
+        },
+    )
+    .unwrap();
+    assert!(stuck_samples > 10, "never stuck");
+    assert!(slipping_after_stick, "never broke loose");
+}

@@ -1,0 +1,682 @@
+//! The simulator: Dormand–Prince 5(4) with its 4th-order dense output, and Coulomb friction as
+//! the hybrid stick/slip system of `effects.md`.
+//!
+//! Why our own integrator: the state has two components and the right-hand side costs ~10 ns, so
+//! generic solver overhead dominates (`notes/crates.md`: 170–190 ns/step for a crate's DOPRI5 vs
+//! ~45 ns for a hand RK4 step). The stick/slip logic also needs to own the step loop.
+//!
+//! Hybrid system: while slipping in direction d = ±1 the friction term is (M·N + c)·d, a smooth
+//! right-hand side; the event θ̇ = 0 is located on the dense output. At the event the applied
+//! torque Q (everything but friction, at θ̇ = 0) is compared with the static capacity C = M·N + c:
+//! |Q| ≤ C → stick (θ̇ = 0 exactly, θ fixed) until |Q(t)| > C(t); otherwise slip in direction sgn Q.
+
+use std::ops::ControlFlow;
+
+use serde::{Deserialize, Serialize};
+
+use crate::{Dimensionless, Excitation, ModelError};
+
+/// A model ready to integrate: parameters plus what drives the base.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Model {
+    pub params: Dimensionless,
+    pub excitation: Excitation,
+}
+
+impl Model {
+    /// The dimensionless model driven by its own constant-speed crank (φ = ωt).
+    pub fn new(params: Dimensionless) -> Self {
+        Self {
+            excitation: Excitation::from_dimensionless(&params),
+            params,
+        }
+    }
+
+    /// Same parameters, another excitation.
+    pub fn with_excitation(params: Dimensionless, excitation: Excitation) -> Self {
+        Self { params, excitation }
+    }
+
+    fn has_dry_friction(&self) -> bool {
+        self.params.m_coulomb > 0.0 || self.params.c > 0.0
+    }
+
+    /// Non-friction torque at rest, Q, and the static friction capacity C, at (t, θ).
+    #[inline]
+    pub fn static_balance(&self, t: f64, theta: f64) -> (f64, f64) {
+        let p = &self.params;
+        let (ay, ax) = self.excitation.accel(t);
+        let (s, c) = theta.sin_cos();
+        let mut q = -(1.0 + ay) * s - ax * c;
+        if p.p != 0.0 {
+            q -= p.p * (p.k as f64 * theta + p.phi_p).sin();
+        }
+        let load = if p.base_load {
+            ((1.0 + ay) * c - ax * s).abs()
+        } else {
+            c.abs()
+        };
+        (q, p.m_coulomb * load + p.c)
+    }
+
+    /// θ̈ while slipping in direction `dir` (±1; 0 when there is no dry friction).
+    #[inline]
+    pub fn accel(&self, t: f64, theta: f64, theta_dot: f64, dir: f64) -> f64 {
+        let p = &self.params;
+        let (ay, ax) = self.excitation.accel(t);
+        let (s, c) = theta.sin_cos();
+        let w2 = theta_dot * theta_dot;
+        let mut q =
+            -(1.0 + ay) * s - ax * c - p.beta * theta_dot - p.alpha * theta_dot * theta_dot.abs();
+        if dir != 0.0 {
+            let load = if p.base_load {
+                (w2 + (1.0 + ay) * c - ax * s).abs()
+            } else {
+                (w2 + c).abs()
+            };
+            q -= (p.m_coulomb * load + p.c) * dir;
+        }
+        if p.p != 0.0 {
+            q -= p.p * (p.k as f64 * theta + p.phi_p).sin();
+        }
+        if p.j != 0.0 {
+            q / (1.0 + p.j)
+        } else {
+            q
+        }
+    }
+
+    /// Mechanical energy per m g l of the unforced pendulum: (1 + j) θ̇²/2 − cos θ.
+    pub fn energy(&self, theta: f64, theta_dot: f64) -> f64 {
+        0.5 * (1.0 + self.params.j) * theta_dot * theta_dot - theta.cos()
+    }
+}
+
+/// Integrator settings.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SimOptions {
+    /// Relative tolerance (θ is scaled by min(|θ|, π): it is an angle, its accuracy is absolute).
+    pub rtol: f64,
+    /// Absolute tolerance.
+    pub atol: f64,
+    /// Largest step (dimensionless time); keeps θ̇ sign changes from hiding inside a step.
+    pub h_max: f64,
+    /// Give up after this many steps.
+    pub max_steps: u64,
+}
+
+impl Default for SimOptions {
+    fn default() -> Self {
+        Self {
+            rtol: 1e-8,
+            atol: 1e-8,
+            h_max: 0.5,
+            max_steps: 50_000_000,
+        }
+    }
+}
+
+impl SimOptions {
+    /// Both tolerances set to `tol`.
+    pub fn with_tol(tol: f64) -> Self {
+        Self {
+            rtol: tol,
+            atol: tol,
+            ..Self::default()
+        }
+    }
+}
+
+/// Counters of one integration.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct SimStats {
+    pub steps: u64,
+    pub rejected: u64,
+    pub rhs_evals: u64,
+    /// θ̇ = 0 events located.
+    pub events: u64,
+    /// Times the pendulum stuck.
+    pub sticks: u64,
+    /// True if the integration ended stuck (θ̇ = 0 exactly).
+    pub ended_stuck: bool,
+    /// True if the callback stopped the integration early.
+    pub stopped_early: bool,
+}
+
+/// Dormand–Prince 5(4) coefficients.
+mod dp {
+    pub const C2: f64 = 1.0 / 5.0;
+    pub const C3: f64 = 3.0 / 10.0;
+    pub const C4: f64 = 4.0 / 5.0;
+    pub const C5: f64 = 8.0 / 9.0;
+    pub const A21: f64 = 1.0 / 5.0;
+    pub const A31: f64 = 3.0 / 40.0;
+    pub const A32: f64 = 9.0 / 40.0;
+    pub const A41: f64 = 44.0 / 45.0;
+    pub const A42: f64 = -56.0 / 15.0;
+    pub const A43: f64 = 32.0 / 9.0;
+    pub const A51: f64 = 19372.0 / 6561.0;
+    pub const A52: f64 = -25360.0 / 2187.0;
+    pub const A53: f64 = 64448.0 / 6561.0;
+    pub const A54: f64 = -212.0 / 729.0;
+    pub const A61: f64 = 9017.0 / 3168.0;
+    pub const A62: f64 = -355.0 / 33.0;
+    pub const A63: f64 = 46732.0 / 5247.0;
+    pub const A64: f64 = 49.0 / 176.0;
+    pub const A65: f64 = -5103.0 / 18656.0;
+    pub const A71: f64 = 35.0 / 384.0;
+    pub const A73: f64 = 500.0 / 1113.0;
+    pub const A74: f64 = 125.0 / 192.0;
+    pub const A75: f64 = -2187.0 / 6784.0;
+    pub const A76: f64 = 11.0 / 84.0;
+    pub const E1: f64 = 71.0 / 57600.0;
+    pub const E3: f64 = -71.0 / 16695.0;
+    pub const E4: f64 = 71.0 / 1920.0;
+    pub const E5: f64 = -17253.0 / 339200.0;
+    pub const E6: f64 = 22.0 / 525.0;
+    pub const E7: f64 = -1.0 / 40.0;
+    // Dense output (Hairer & Wanner's DOPRI5 continuous extension).
+    pub const D1: f64 = -12715105075.0 / 11282082432.0;
+    pub const D3: f64 = 87487479700.0 / 32700410799.0;
+    pub const D4: f64 = -10690763975.0 / 1880347072.0;
+    pub const D5: f64 = 701980252875.0 / 199316789632.0;
+    pub const D6: f64 = -1453857185.0 / 822651844.0;
+    pub const D7: f64 = 69997945.0 / 29380423.0;
+}
+
+type Y = [f64; 2];
+
+/// Dense output of one accepted step on [t, t + h].
+#[derive(Clone, Copy)]
+struct Dense {
+    t: f64,
+    h: f64,
+    r: [Y; 5],
+}
+
+impl Dense {
+    #[inline]
+    fn eval(&self, t: f64) -> Y {
+        let s = (t - self.t) / self.h;
+        let s1 = 1.0 - s;
+        let mut y = [0.0; 2];
+        for (i, yi) in y.iter_mut().enumerate() {
+            let r = &self.r;
+            *yi = r[0][i] + s * (r[1][i] + s1 * (r[2][i] + s * (r[3][i] + s1 * r[4][i])));
+        }
+        y
+    }
+}
+
+/// One output sample (dimensionless time and state).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Sample {
+    pub t: f64,
+    pub theta: f64,
+    pub theta_dot: f64,
+}
+
+/// A sampled trajectory.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Trajectory {
+    pub t: Vec<f64>,
+    pub theta: Vec<f64>,
+    pub theta_dot: Vec<f64>,
+    pub stats: SimStats,
+}
+
+/// Integrates `model` from (t0, θ0, θ̇0) to `t_end`, calling `sink` at each time of `times`
+/// (increasing, within [t0, t_end]) with the state there. `sink` may stop the run early
+/// (`ControlFlow::Break`): that is how a fit abandons a trial that cannot win.
+pub fn integrate<I, F>(
+    model: &Model,
+    opts: &SimOptions,
+    t0: f64,
+    y0: [f64; 2],
+    t_end: f64,
+    times: I,
+    mut sink: F,
+) -> Result<SimStats, ModelError>
+where
+    I: IntoIterator<Item = f64>,
+    F: FnMut(Sample) -> ControlFlow<()>,
+{
+    if !(y0[0].is_finite() && y0[1].is_finite() && t0.is_finite() && t_end.is_finite()) {
+        return Err(ModelError::BadInput(format!(
+            "non-finite start: t0={t0}, theta={}, theta_dot={}, t_end={t_end}",
+            y0[0], y0[1]
+        )));
+    }
+    let mut times = times.into_iter().peekable();
+    let mut stats = SimStats::default();
+    let dry = model.has_dry_friction();
+    let mut t = t0;
+    let mut y = y0;
+    // Slip direction; 0 = stuck (only with dry friction) or no dry friction at all.
+    let mut dir: f64;
+    let mut stuck = false;
+    macro_rules! emit {
+        ($tt:expr, $yy:expr) => {{
+            let yy: Y = $yy;
+            if sink(Sample {
+                t: $tt,
+                theta: yy[0],
+                theta_dot: yy[1],
+            })
+            .is_break()
+            {
+                stats.stopped_early = true;
+                return Ok(stats);
+            }
+        }};
+    }
+    // Skip requested times before t0.
+    while let Some(&ts) = times.peek() {
+        if ts < t0 - 1e-12 * t0.abs().max(1.0) {
+            times.next();
+        } else {
+            break;
+        }
+    }
+    if dry {
+        if y[1] != 0.0 {
+            dir = y[1].signum();
+        } else {
+            let (q, c) = model.static_balance(t, y[0]);
+            if q.abs() <= c {
+                stuck = true;
+                dir = 0.0;
+            } else {
+                dir = q.signum();
+            }
+        }
+    } else {
+        dir = 0.0;
+    }
+    let mut h = 1e-2_f64.min(opts.h_max);
+    let mut err_old: f64 = 1e-4;
+    let mut k1: Y = [0.0; 2];
+    let mut need_k1 = true;
+
+    while t < t_end {
+        if stuck {
+            stats.sticks += 1;
+            y[1] = 0.0;
+            // Find when the pendulum breaks loose, if ever.
+            let t_break = if model.excitation.is_still() {
+                None
+            } else {
+                find_breakaway(model, t, y[0], t_end)
+            };
+            let t_until = t_break.unwrap_or(t_end);
+            while let Some(&ts) = times.peek() {
+                if ts <= t_until {
+                    times.next();
+                    emit!(ts, [y[0], 0.0]);
+                } else {
+                    break;
+                }
+            }
+            match t_break {
+                None => {
+                    stats.ended_stuck = true;
+                    return Ok(stats);
+                }
+                Some(tb) => {
+                    t = tb;
+                    let (q, _) = model.static_balance(t, y[0]);
+                    dir = q.signum();
+                    stuck = false;
+                    need_k1 = true;
+                    h = h.min(1e-2);
+                    continue;
+                }
+            }
+        }
+        if stats.steps >= opts.max_steps {
+            return Err(ModelError::TooManySteps {
+                steps: stats.steps,
+                t,
+            });
+        }
+        if need_k1 {
+            k1 = f(model, t, y, dir);
+            stats.rhs_evals += 1;
+            need_k1 = false;
+        }
+        let last = t + h >= t_end;
+        if last {
+            h = t_end - t;
+        }
+        // One DOPRI5 step.
+        let k2 = f(model, t + dp::C2 * h, add(y, h, &[(dp::A21, k1)]), dir);
+        let k3 = f(
+            model,
+            t + dp::C3 * h,
+            add(y, h, &[(dp::A31, k1), (dp::A32, k2)]),
+            dir,
+        );
+        let k4 = f(
+            model,
+            t + dp::C4 * h,
+            add(y, h, &[(dp::A41, k1), (dp::A42, k2), (dp::A43, k3)]),
+            dir,
+        );
+        let k5 = f(
+            model,
+            t + dp::C5 * h,
+            add(
+                y,
+                h,
+                &[(dp::A51, k1), (dp::A52, k2), (dp::A53, k3), (dp::A54, k4)],
+            ),
+            dir,
+        );
+        let y6 = add(
+            y,
+            h,
+            &[
+                (dp::A61, k1),
+                (dp::A62, k2),
+                (dp::A63, k3),
+                (dp::A64, k4),
+                (dp::A65, k5),
+            ],
+        );
+        let k6 = f(model, t + h, y6, dir);
+        let y_new = add(
+            y,
+            h,
+            &[
+                (dp::A71, k1),
+                (dp::A73, k3),
+                (dp::A74, k4),
+                (dp::A75, k5),
+                (dp::A76, k6),
+            ],
+        );
+        let k7 = f(model, t + h, y_new, dir);
+        stats.rhs_evals += 6;
+        let mut err = 0.0;
+        for i in 0..2 {
+            let e = h
+                * (dp::E1 * k1[i]
+                    + dp::E3 * k3[i]
+                    + dp::E4 * k4[i]
+                    + dp::E5 * k5[i]
+                    + dp::E6 * k6[i]
+                    + dp::E7 * k7[i]);
+            let mut mag = y[i].abs().max(y_new[i].abs());
+            if i == 0 {
+                mag = mag.min(std::f64::consts::PI);
+            }
+            let sc = opts.atol + opts.rtol * mag;
+            err += (e / sc) * (e / sc);
+        }
+        let err = (err / 2.0).sqrt();
+        if !err.is_finite() {
+            h *= 0.1;
+            stats.rejected += 1;
+            if h < 1e-14 {
+                return Err(ModelError::StepUnderflow { t });
+            }
+            continue;
+        }
+        // PI step-size control (Hairer's DOPRI5 constants).
+        let beta = 0.04;
+        let fac11 = err.powf(0.2 - 0.75 * beta);
+        let fac = (fac11 / err_old.powf(beta) / 0.9).clamp(0.1, 5.0);
+        let h_next = (h / fac).min(opts.h_max);
+        if err > 1.0 {
+            stats.rejected += 1;
+            h = h / (fac11 / 0.9).min(5.0);
+            if h < 1e-14 * t.abs().max(1.0) {
+                return Err(ModelError::StepUnderflow { t });
+            }
+            continue;
+        }
+        stats.steps += 1;
+        err_old = err.max(1e-4);
+        let ydiff = [y_new[0] - y[0], y_new[1] - y[1]];
+        let bspl = [h * k1[0] - ydiff[0], h * k1[1] - ydiff[1]];
+        let dense = Dense {
+            t,
+            h,
+            r: [
+                y,
+                ydiff,
+                bspl,
+                [
+                    ydiff[0] - h * k7[0] - bspl[0],
+                    ydiff[1] - h * k7[1] - bspl[1],
+                ],
+                [
+                    h * (dp::D1 * k1[0]
+                        + dp::D3 * k3[0]
+                        + dp::D4 * k4[0]
+                        + dp::D5 * k5[0]
+                        + dp::D6 * k6[0]
+                        + dp::D7 * k7[0]),
+                    h * (dp::D1 * k1[1]
+                        + dp::D3 * k3[1]
+                        + dp::D4 * k4[1]
+                        + dp::D5 * k5[1]
+                        + dp::D6 * k6[1]
+                        + dp::D7 * k7[1]),
+                ],
+            ],
+        };
+        let t_new = if last { t_end } else { t + h };
+        // Did θ̇ reach zero against the slip direction?
+        let crossing = dir != 0.0 && y_new[1] * dir <= 0.0;
+        if crossing {
+            let te = locate_zero(&dense, t, t_new, dir);
+            stats.events += 1;
+            let mut ye = dense.eval(te);
+            ye[1] = 0.0;
+            while let Some(&ts) = times.peek() {
+                if ts < te {
+                    times.next();
+                    emit!(ts, dense.eval(ts));
+                } else {
+                    break;
+                }
+            }
+            t = te;
+            y = ye;
+            let (q, c) = model.static_balance(t, y[0]);
+            if q.abs() <= c {
+                stuck = true;
+                dir = 0.0;
+            } else {
+                dir = q.signum();
+            }
+            need_k1 = true;
+            h = h_next.min(h);
+            continue;
+        }
+        while let Some(&ts) = times.peek() {
+            if ts <= t_new {
+                times.next();
+                emit!(ts, dense.eval(ts));
+            } else {
+                break;
+            }
+        }
+        t = t_new;
+        y = y_new;
+        k1 = k7;
+        h = h_next;
+    }
+    Ok(stats)
+}
+
+#[inline]
+fn f(model: &Model, t: f64, y: Y, dir: f64) -> Y {
+    [y[1], model.accel(t, y[0], y[1], dir)]
+}
+
+#[inline]
+fn add(y: Y, h: f64, terms: &[(f64, Y)]) -> Y {
+    let mut out = y;
+    for (a, k) in terms {
+        out[0] += h * a * k[0];
+        out[1] += h * a * k[1];
+    }
+    out
+}
+
+/// Root of θ̇ on the dense output in (a, b], where θ̇·dir > 0 at a and ≤ 0 at b (Illinois).
+fn locate_zero(dense: &Dense, a: f64, b: f64, dir: f64) -> f64 {
+    let g = |t: f64| dense.eval(t)[1] * dir;
+    let (mut a, mut b) = (a, b);
+    let (mut ga, mut gb) = (g(a), g(b));
+    if ga <= 0.0 {
+        return a;
+    }
+    let mut side = 0;
+    for _ in 0..100 {
+        let m = if (ga - gb).abs() > 0.0 {
+            (a * gb - b * ga) / (gb - ga)
+        } else {
+            0.5 * (a + b)
+        };
+        let m = if m > a && m < b { m } else { 0.5 * (a + b) };
+        let gm = g(m);
+        if gm > 0.0 {
+            a = m;
+            ga = gm;
+            if side == -1 {
+                gb *= 0.5;
+            }
+            side = -1;
+        } else {
+            b = m;
+            gb = gm;
+            if side == 1 {
+                ga *= 0.5;
+            }
+            side = 1;
+        }
+        if (b - a) <= 1e-14 * b.abs().max(1.0) {
+            break;
+        }
+    }
+    b
+}
+
+/// First time after `t` when a stuck pendulum at θ breaks loose (|Q| > C), or `None` before t_end.
+fn find_breakaway(model: &Model, t: f64, theta: f64, t_end: f64) -> Option<f64> {
+    let excess = |tt: f64| {
+        let (q, c) = model.static_balance(tt, theta);
+        q.abs() - c
+    };
+    // Scan finely enough for the forcing (64 points per period) and the measured signal's grid.
+    let mut h = match &model.excitation {
+        Excitation::Crank(c) => 2.0 * std::f64::consts::PI / c.omega.max(1e-3) / 64.0,
+        Excitation::Measured(m) => m.dt * 0.5,
+        Excitation::None => return None,
+    };
+    h = h.min(0.1);
+    let mut a = t;
+    while a < t_end {
+        let b = (a + h).min(t_end);
+        if excess(b) > 0.0 {
+            // Bisect: excess(a) ≤ 0 < excess(b).
+            let (mut lo, mut hi) = (a, b);
+            for _ in 0..60 {
+                let m = 0.5 * (lo + hi);
+                if excess(m) > 0.0 {
+                    hi = m;
+                } else {
+                    lo = m;
+                }
+                if hi - lo <= 1e-13 * hi.abs().max(1.0) {
+                    break;
+                }
+            }
+            return Some(hi);
+        }
+        a = b;
+    }
+    None
+}
+
+/// Uniform output times t0, t0 + dt, … ≤ t_end.
+pub fn uniform_times(t0: f64, t_end: f64, dt: f64) -> impl Iterator<Item = f64> {
+    let n = if dt > 0.0 {
+        ((t_end - t0) / dt + 1e-9).floor() as u64 + 1
+    } else {
+        1
+    };
+    (0..n).map(move |k| t0 + k as f64 * dt)
+}
+
+/// Integrates and samples on a uniform grid of step `dt_out`.
+pub fn simulate(
+    model: &Model,
+    opts: &SimOptions,
+    y0: [f64; 2],
+    t0: f64,
+    t_end: f64,
+    dt_out: f64,
+) -> Result<Trajectory, ModelError> {
+    if !(dt_out > 0.0) || !(t_end > t0) {
+        return Err(ModelError::BadInput(format!(
+            "need t_end > t0 and dt_out > 0 (t0={t0}, t_end={t_end}, dt_out={dt_out})"
+        )));
+    }
+    let mut tr = Trajectory::default();
+    let stats = integrate(
+        model,
+        opts,
+        t0,
+        y0,
+        t_end,
+        uniform_times(t0, t_end, dt_out),
+        |s| {
+            tr.t.push(s.t);
+            tr.theta.push(s.theta);
+            tr.theta_dot.push(s.theta_dot);
+            ControlFlow::Continue(())
+        },
+    )?;
+    tr.stats = stats;
+    Ok(tr)
+}
+
+/// Plain fixed-step classical RK4 with `sgn θ̇` friction: the benchmark's and tests' baseline.
+/// It knows nothing of stick/slip, so use it only where θ̇ never rests at zero.
+pub fn rk4_fixed(model: &Model, y0: [f64; 2], t0: f64, t_end: f64, h: f64) -> [f64; 2] {
+    let n = ((t_end - t0) / h).round() as u64;
+    let mut y = y0;
+    let mut t = t0;
+    let rhs = |t: f64, y: Y| -> Y {
+        let dir = if y[1] > 0.0 {
+            1.0
+        } else if y[1] < 0.0 {
+            -1.0
+        } else {
+            0.0
+        };
+        [y[1], model.accel(t, y[0], y[1], dir)]
+    };
+    for _ in 0..n {
+        let k1 = rhs(t, y);
+        let k2 = rhs(
+            t + 0.5 * h,
+            [y[0] + 0.5 * h * k1[0], y[1] + 0.5 * h * k1[1]],
+        );
+        let k3 = rhs(
+            t + 0.5 * h,
+            [y[0] + 0.5 * h * k2[0], y[1] + 0.5 * h * k2[1]],
+        );
+        let k4 = rhs(t + h, [y[0] + h * k3[0], y[1] + h * k3[1]]);
+        for i in 0..2 {
+            y[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
+        }
+        t += h;
+    }
+    y
+}

@@ -1,0 +1,297 @@
+//! Steady-state classes from a Poincaré section (one sample per forcing period after a transient).
+//!
+//! The names (`rest`, `oscillation`, `rotation_ccw`, `rotation_cw`, `chaos`) are used in every
+//! output of the project.
+
+use std::fmt;
+use std::ops::ControlFlow;
+use std::str::FromStr;
+
+use serde::{Deserialize, Serialize};
+
+use crate::sim::{integrate, Model, SimOptions};
+use crate::ModelError;
+
+/// The kind of motion a run settles into.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SteadyClass {
+    Rest,
+    Oscillation,
+    /// θ increasing.
+    RotationCcw,
+    /// θ decreasing.
+    RotationCw,
+    Chaos,
+}
+
+impl SteadyClass {
+    pub const ALL: [SteadyClass; 5] = [
+        SteadyClass::Rest,
+        SteadyClass::Oscillation,
+        SteadyClass::RotationCcw,
+        SteadyClass::RotationCw,
+        SteadyClass::Chaos,
+    ];
+
+    pub fn as_str(self) -> &'static str {
+        match self {
+            SteadyClass::Rest => "rest",
+            SteadyClass::Oscillation => "oscillation",
+            SteadyClass::RotationCcw => "rotation_ccw",
+            SteadyClass::RotationCw => "rotation_cw",
+            SteadyClass::Chaos => "chaos",
+        }
+    }
+
+    pub fn is_rotation(self) -> bool {
+        matches!(self, SteadyClass::RotationCcw | SteadyClass::RotationCw)
+    }
+}
+
+impl fmt::Display for SteadyClass {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+impl FromStr for SteadyClass {
+    type Err = ModelError;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        SteadyClass::ALL
+            .into_iter()
+            .find(|c| c.as_str() == s)
+            .ok_or_else(|| ModelError::BadInput(format!(
+                "unknown steady state {s:?}: expected rest, oscillation, rotation_ccw, rotation_cw or chaos"
+            )))
+    }
+}
+
+/// A class with its period in forcing periods (0 for rest and chaos).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct SteadyState {
+    pub class: SteadyClass,
+    pub period: u32,
+    /// Mean θ̇ over the recorded section (dimensionless); the rotation speed for rotations.
+    pub mean_theta_dot: f64,
+}
+
+impl fmt::Display for SteadyState {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self.class {
+            SteadyClass::Rest | SteadyClass::Chaos => write!(f, "{}", self.class),
+            _ => write!(f, "{} (period {})", self.class, self.period),
+        }
+    }
+}
+
+/// Tolerances of the classifier. Defaults suit simulations; measured data need tolerances above
+/// the encoder's resolution and noise.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ClassifyOptions {
+    /// Two Poincaré points repeat when θ (mod 2π) agrees within this, rad.
+    pub theta_tol: f64,
+    /// … and θ̇ agrees within this (dimensionless).
+    pub theta_dot_tol: f64,
+    /// Longest period looked for, in forcing periods.
+    pub max_period: u32,
+    /// Motion whose θ stays within this of its mean (and θ̇ within `theta_dot_tol` of 0) is rest.
+    pub rest_tol: f64,
+}
+
+impl Default for ClassifyOptions {
+    fn default() -> Self {
+        Self {
+            theta_tol: 1e-3,
+            theta_dot_tol: 1e-3,
+            max_period: 16,
+            rest_tol: 1e-4,
+        }
+    }
+}
+
+fn wrap_pi(x: f64) -> f64 {
+    let two_pi = 2.0 * std::f64::consts::PI;
+    let y = (x + std::f64::consts::PI).rem_euclid(two_pi);
+    y - std::f64::consts::PI
+}
+
+/// Classifies Poincaré points (θ unwrapped, θ̇), one per forcing period, transient removed.
+pub fn classify_poincare(theta: &[f64], theta_dot: &[f64], opts: &ClassifyOptions) -> SteadyState {
+    let n = theta.len().min(theta_dot.len());
+    let mean_theta_dot = if n >= 2 {
+        // Net drift per period, robust to where the section falls within a rotation.
+        (theta[n - 1] - theta[0]) / (n - 1) as f64
+    } else {
+        0.0
+    };
+    if n < 2 {
+        return SteadyState {
+            class: SteadyClass::Chaos,
+            period: 0,
+            mean_theta_dot: 0.0,
+        };
+    }
+    let mean = theta[..n].iter().sum::<f64>() / n as f64;
+    let still = theta[..n].iter().all(|t| (t - mean).abs() <= opts.rest_tol)
+        && theta_dot[..n].iter().all(|w| w.abs() <= opts.theta_dot_tol);
+    if still {
+        return SteadyState {
+            class: SteadyClass::Rest,
+            period: 0,
+            mean_theta_dot: 0.0,
+        };
+    }
+    let max_p = (opts.max_period as usize).min(n / 2);
+    for p in 1..=max_p {
+        let repeats = (0..n - p).all(|k| {
+            wrap_pi(theta[k + p] - theta[k]).abs() <= opts.theta_tol
+                && (theta_dot[k + p] - theta_dot[k]).abs() <= opts.theta_dot_tol
+        });
+        if repeats {
+            // Net turns over one period of the orbit.
+            let turns = ((theta[p] - theta[0]) / (2.0 * std::f64::consts::PI)).round();
+            let class = if turns > 0.0 {
+                SteadyClass::RotationCcw
+            } else if turns < 0.0 {
+                SteadyClass::RotationCw
+            } else {
+                SteadyClass::Oscillation
+            };
+            return SteadyState {
+                class,
+                period: p as u32,
+                mean_theta_dot: if class.is_rotation() {
+                    mean_theta_dot
+                } else {
+                    0.0
+                },
+            };
+        }
+    }
+    SteadyState {
+        class: SteadyClass::Chaos,
+        period: 0,
+        mean_theta_dot,
+    }
+}
+
+/// Simulates past a transient of `transient_periods` forcing periods, records `record_periods`
+/// Poincaré points (at t = t0 + k·T, the forcing phase of t0) and classifies them.
+/// Returns the class and the recorded points (θ, θ̇).
+pub fn steady_state_of(
+    model: &Model,
+    opts: &SimOptions,
+    y0: [f64; 2],
+    t0: f64,
+    transient_periods: u32,
+    record_periods: u32,
+    copts: &ClassifyOptions,
+) -> Result<(SteadyState, Vec<f64>, Vec<f64>), ModelError> {
+    let period = model.params.forcing_period();
+    let period = if period.is_finite() {
+        period
+    } else {
+        2.0 * std::f64::consts::PI
+    };
+    let t_rec = t0 + transient_periods as f64 * period;
+    let t_end = t_rec + record_periods as f64 * period;
+    let mut th = Vec::with_capacity(record_periods as usize + 1);
+    let mut thd = Vec::with_capacity(record_periods as usize + 1);
+    let times = (0..=record_periods).map(|k| t_rec + k as f64 * period);
+    let stats = integrate(model, opts, t0, y0, t_end, times, |s| {
+        th.push(s.theta);
+        thd.push(s.theta_dot);
+        ControlFlow::Continue(())
+    })?;
+    let _ = stats;
+    Ok((classify_poincare(&th, &thd, copts), th, thd))
+}
+
+/// Classifies a sampled θ(t) history — simulated or measured — without θ̇: samples θ at one
+/// point per period, and uses θ a quarter period later as the second coordinate (it plays θ̇'s
+/// role and needs no differentiation of noisy data). `t` must be increasing.
+pub fn classify_history(
+    t: &[f64],
+    theta: &[f64],
+    period: f64,
+    t_from: f64,
+    opts: &ClassifyOptions,
+) -> Result<SteadyState, ModelError> {
+    if t.len() != theta.len() || t.len() < 4 {
+        return Err(ModelError::BadInput(format!(
+            "history needs ≥ 4 samples and equal lengths (t {}, theta {})",
+            t.len(),
+            theta.len()
+        )));
+    }
+    if !(period > 0.0) {
+        return Err(ModelError::BadInput(format!("period {period} must be > 0")));
+    }
+    let interp = |x: f64| -> f64 {
+        let i = t.partition_point(|&v| v < x).clamp(1, t.len() - 1);
+        let (t0, t1) = (t[i - 1], t[i]);
+        let w = if t1 > t0 { (x - t0) / (t1 - t0) } else { 0.0 };
+        theta[i - 1] + w * (theta[i] - theta[i - 1])
+    };
+    let t_last = t[t.len() - 1] - 0.25 * period;
+    let mut a = Vec::new();
+    let mut b = Vec::new();
+    let mut x = t_from.max(t[0]);
+    while x <= t_last {
+        a.push(interp(x));
+        // The quarter-period-later angle difference, scaled to θ̇ units.
+        b.push((interp(x + 0.25 * period) - interp(x)) / (0.25 * period));
+        x += period;
+    }
+    if a.len() < 2 {
+        return Err(ModelError::BadInput(format!(
+            "history from t={t_from} holds fewer than 2 forcing periods of {period}"
+        )));
+    }
+    Ok(classify_poincare(&a, &b, opts))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_round_trip() {
+        for c in SteadyClass::ALL {
+            assert_eq!(c.as_str().parse::<SteadyClass>().unwrap(), c);
+        }
+        assert!("spinning".parse::<SteadyClass>().is_err());
+    }
+
+    #[test]
+    fn synthetic_sections() {
+        let o = ClassifyOptions::default();
+        let two_pi = 2.0 * std::f64::consts::PI;
+        // Period-2 oscillation.
+        let th: Vec<f64> = (0..40)
+            .map(|k| if k % 2 == 0 { 0.5 } else { -0.4 })
+            .collect();
+        let w: Vec<f64> = (0..40)
+            .map(|k| if k % 2 == 0 { 0.1 } else { -0.2 })
+            .collect();
+        let s = classify_poincare(&th, &w, &o);
+        assert_eq!((s.class, s.period), (SteadyClass::Oscillation, 2));
+        // Period-1 clockwise rotation: one turn per period.
+        let th: Vec<f64> = (0..40).map(|k| 0.3 - two_pi * k as f64).collect();
+        let w = vec![-1.2; 40];
+        let s = classify_poincare(&th, &w, &o);
+        assert_eq!((s.class, s.period), (SteadyClass::RotationCw, 1));
+        assert!((s.mean_theta_dot + two_pi).abs() < 1e-12);
+        // Rest.
+        let s = classify_poincare(&[0.01; 30], &[0.0; 30], &o);
+        assert_eq!(s.class, SteadyClass::Rest);
+        // Irregular.
+        let th: Vec<f64> = (0..60)
+            .map(|k| ((k * k * 7919) % 101) as f64 * 0.05)
+            .collect();
+        let s = classify_poincare(&th, &th, &o);
+        assert_eq!(s.class, SteadyClass::Chaos);
+    }
+}
