@@ -1,0 +1,118 @@
+//! The `pendulum` binary: parses arguments, calls the library crates, prints results and errors
+//! (with their chain), maps failures to exit codes. No logic lives here.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+use pendulum_jobs::{demo, simulate};
+use pendulum_model::SteadyClass;
+
+#[derive(Parser)]
+#[command(
+    name = "pendulum",
+    version,
+    about = "Parametric-pendulum rig logs in, damping answers out"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Integrate the dimensionless equation of motion (the study's Eq. 5, plus any effects) and
+    /// write t, theta, theta_dot to Parquet with the steady state in its metadata.
+    Simulate(SimulateArgs),
+    /// Run the main job on built-in data.
+    Demo(DemoArgs),
+}
+
+#[derive(clap::Args)]
+struct SimulateArgs {
+    /// A parameter, `key=value`: dimensionless omega, R, lambda, alpha, beta, M; physical m_kg,
+    /// l_m, crank_r_m, rod_L_m, r_b_m, omega_hz, g_m_s2, a, b, mu; effects such as
+    /// coulomb_constant.T_c. Unset ones come from the study's rig. Repeatable.
+    #[arg(long = "param", value_name = "KEY=VALUE")]
+    params: Vec<String>,
+    /// Initial angle from hanging, rad.
+    #[arg(long, default_value_t = 0.5, allow_negative_numbers = true)]
+    theta0: f64,
+    /// Initial dimensionless angular velocity.
+    #[arg(
+        long = "theta-dot0",
+        default_value_t = 0.0,
+        allow_negative_numbers = true
+    )]
+    theta_dot0: f64,
+    /// End time, dimensionless (t = ω0·τ).
+    #[arg(long = "t-end", default_value_t = 300.0)]
+    t_end: f64,
+    /// Output spacing, dimensionless.
+    #[arg(long = "dt-out", default_value_t = 0.05)]
+    dt_out: f64,
+    /// Integrator tolerance (relative and absolute).
+    #[arg(long, default_value_t = 1e-8)]
+    tol: f64,
+    /// Output Parquet file.
+    #[arg(long)]
+    out: Option<PathBuf>,
+}
+
+#[derive(clap::Args)]
+struct DemoArgs {
+    /// Initial-condition grid size per axis (grid × grid starts per configuration).
+    #[arg(long, default_value_t = 4)]
+    grid: usize,
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match run(cli) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            for cause in e.chain().skip(1) {
+                eprintln!("  caused by: {cause}");
+            }
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn run(cli: Cli) -> anyhow::Result<()> {
+    match cli.command {
+        Command::Simulate(a) => {
+            let summary = simulate::run(&simulate::SimulateJob {
+                params: a.params,
+                theta0: a.theta0,
+                theta_dot0: a.theta_dot0,
+                t_end: a.t_end,
+                dt_out: a.dt_out,
+                tol: a.tol,
+                out: a.out,
+            })?;
+            println!("{summary}");
+        }
+        Command::Demo(a) => {
+            println!(
+                "Study configurations (R = 0.7, λ = 0.126), {0}×{0} starts each, steady states:",
+                a.grid
+            );
+            let rows = demo::run(a.grid)?;
+            print!("{:<10} {:>6}", "model", "omega");
+            for c in SteadyClass::ALL {
+                print!(" {:>12}", c.as_str());
+            }
+            println!();
+            for r in rows {
+                print!("{:<10} {:>6.3}", r.model, r.omega);
+                for n in r.counts {
+                    print!(" {n:>12}");
+                }
+                println!();
+            }
+        }
+    }
+    Ok(())
+}

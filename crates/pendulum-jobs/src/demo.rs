@@ -1,0 +1,76 @@
+//! `pendulum demo`: the main job on built-in data. For now: the study's two damping models at a
+//! few forcing frequencies, each from a grid of initial states, with the steady states they reach.
+
+use pendulum_model::steady::steady_state_of;
+use pendulum_model::{ClassifyOptions, Dimensionless, Model, SimOptions, SteadyClass};
+use rayon::prelude::*;
+
+use crate::JobError;
+
+/// One configuration's outcome.
+#[derive(Debug, Clone)]
+pub struct DemoRow {
+    pub model: &'static str,
+    pub omega: f64,
+    /// Number of starts per class, in `SteadyClass::ALL` order.
+    pub counts: [usize; 5],
+    pub starts: usize,
+}
+
+/// The study's dry-friction model (Fig. 8: β = 0.109, M = 0.007) and the classic linear model
+/// (Fig. 9: β = 0.066, M = 0) at R = 0.7, λ = 0.126.
+pub fn study_models(omega: f64) -> [(&'static str, Dimensionless); 2] {
+    let mut d = Dimensionless::conservative();
+    d.omega = omega;
+    d.r = 0.7;
+    d.lambda = 0.126;
+    let mut reference = d;
+    reference.beta = 0.109;
+    reference.m_coulomb = 0.007;
+    let mut linear = d;
+    linear.beta = 0.066;
+    [("reference", reference), ("linear", linear)]
+}
+
+pub fn run(grid: usize) -> Result<Vec<DemoRow>, JobError> {
+    let omegas = [1.57, 1.585, 2.0, 2.8];
+    let mut jobs = Vec::new();
+    for &w in &omegas {
+        for (name, d) in study_models(w) {
+            jobs.push((name, w, d));
+        }
+    }
+    jobs.par_iter()
+        .map(|&(name, omega, d)| {
+            let model = Model::new(d);
+            let mut counts = [0usize; 5];
+            for i in 0..grid {
+                for j in 0..grid {
+                    let th0 =
+                        -std::f64::consts::PI + 2.0 * std::f64::consts::PI * i as f64 / grid as f64;
+                    let w0 = -3.0 + 6.0 * j as f64 / grid as f64;
+                    let (s, _, _) = steady_state_of(
+                        &model,
+                        &SimOptions::with_tol(1e-8),
+                        [th0, w0],
+                        0.0,
+                        200,
+                        32,
+                        &ClassifyOptions::default(),
+                    )?;
+                    let k = SteadyClass::ALL
+                        .iter()
+                        .position(|c| *c == s.class)
+                        .unwrap_or(4);
+                    counts[k] += 1;
+                }
+            }
+            Ok(DemoRow {
+                model: name,
+                omega,
+                counts,
+                starts: grid * grid,
+            })
+        })
+        .collect()
+}

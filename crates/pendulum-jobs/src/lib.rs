@@ -1,0 +1,25 @@
+//! The jobs the `pendulum` binary offers, as library functions: each takes an options struct,
+//! does the work and returns a summary the binary prints. No argument parsing here, no printing
+//! of results (progress bars excepted).
+
+pub mod demo;
+pub mod simulate;
+
+use std::path::PathBuf;
+
+/// Errors of a job, with the layer that failed.
+#[derive(Debug, thiserror::Error)]
+pub enum JobError {
+    #[error(transparent)]
+    Model(#[from] pendulum_model::ModelError),
+    #[error(transparent)]
+    Report(#[from] pendulum_report::ReportError),
+    #[error("{path}: {source}")]
+    Io {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("{0}")]
+    Invalid(String),
+}

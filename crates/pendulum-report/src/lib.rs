@@ -1,0 +1,309 @@
+//! Parquet tables for dataframe analysis (pandas, polars, DuckDB): typed columns, units in field
+//! metadata, the producing command and versions in the key-value metadata, zstd, written
+//! atomically (a `.name.tmp` beside the target, fsync, rename) so a crash never leaves a
+//! half-written table under the final name.
+
+use std::collections::HashMap;
+use std::fs::File;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use arrow_array::{ArrayRef, BooleanArray, Float64Array, Int64Array, RecordBatch, StringArray};
+use arrow_schema::{DataType, Field, Schema};
+use parquet::arrow::ArrowWriter;
+use parquet::basic::{Compression, ZstdLevel};
+use parquet::file::properties::WriterProperties;
+
+/// Errors of the report crate.
+#[derive(Debug, thiserror::Error)]
+pub enum ReportError {
+    #[error("{path}: {source}")]
+    Io {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("{path}: writing Parquet: {source}")]
+    Parquet {
+        path: PathBuf,
+        #[source]
+        source: parquet::errors::ParquetError,
+    },
+    #[error("{path}: building the table: {source}")]
+    Arrow {
+        path: PathBuf,
+        #[source]
+        source: arrow_schema::ArrowError,
+    },
+    #[error("{path}: column {column:?} has {got} rows, expected {expected}")]
+    RaggedColumns {
+        path: PathBuf,
+        column: String,
+        got: usize,
+        expected: usize,
+    },
+}
+
+/// The values of one column.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ColumnData {
+    F64(Vec<f64>),
+    I64(Vec<i64>),
+    Str(Vec<String>),
+    Bool(Vec<bool>),
+}
+
+impl ColumnData {
+    fn len(&self) -> usize {
+        match self {
+            ColumnData::F64(v) => v.len(),
+            ColumnData::I64(v) => v.len(),
+            ColumnData::Str(v) => v.len(),
+            ColumnData::Bool(v) => v.len(),
+        }
+    }
+}
+
+/// A named column with its unit (stored as field metadata `unit`) and a short description.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Column {
+    pub name: String,
+    pub unit: Option<String>,
+    pub description: Option<String>,
+    pub data: ColumnData,
+}
+
+impl Column {
+    pub fn new(name: &str, data: ColumnData) -> Self {
+        Self {
+            name: name.to_string(),
+            unit: None,
+            description: None,
+            data,
+        }
+    }
+
+    pub fn f64(name: &str, unit: &str, values: Vec<f64>) -> Self {
+        Self::new(name, ColumnData::F64(values)).unit(unit)
+    }
+
+    pub fn unit(mut self, unit: &str) -> Self {
+        self.unit = Some(unit.to_string());
+        self
+    }
+
+    pub fn describe(mut self, text: &str) -> Self {
+        self.description = Some(text.to_string());
+        self
+    }
+}
+
+/// Writer options with sensible defaults (zstd level 3, 64k rows per group).
+#[derive(Debug, Clone)]
+pub struct TableOptions {
+    pub zstd_level: i32,
+    pub row_group_rows: usize,
+    pub metadata: Vec<(String, String)>,
+}
+
+impl Default for TableOptions {
+    fn default() -> Self {
+        Self {
+            zstd_level: 3,
+            row_group_rows: 65_536,
+            metadata: vec![(
+                "pendulum_version".to_string(),
+                env!("CARGO_PKG_VERSION").to_string(),
+            )],
+        }
+    }
+}
+
+impl TableOptions {
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Adds a key-value pair to the file's footer metadata.
+    pub fn meta(mut self, key: &str, value: impl Into<String>) -> Self {
+        self.metadata.push((key.to_string(), value.into()));
+        self
+    }
+
+    /// Writes `columns` to `path` atomically.
+    pub fn write(&self, path: &Path, columns: &[Column]) -> Result<TableSummary, ReportError> {
+        write_table(path, columns, self)
+    }
+}
+
+/// What a write produced.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TableSummary {
+    pub path: PathBuf,
+    pub rows: usize,
+    pub columns: usize,
+    pub bytes: u64,
+}
+
+fn tmp_path(path: &Path) -> PathBuf {
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "table.parquet".into());
+    path.with_file_name(format!(".{name}.tmp"))
+}
+
+fn write_table(
+    path: &Path,
+    columns: &[Column],
+    opts: &TableOptions,
+) -> Result<TableSummary, ReportError> {
+    let rows = columns.first().map_or(0, |c| c.data.len());
+    let mut fields = Vec::with_capacity(columns.len());
+    let mut arrays: Vec<ArrayRef> = Vec::with_capacity(columns.len());
+    for c in columns {
+        if c.data.len() != rows {
+            return Err(ReportError::RaggedColumns {
+                path: path.to_path_buf(),
+                column: c.name.clone(),
+                got: c.data.len(),
+                expected: rows,
+            });
+        }
+        let (dt, arr): (DataType, ArrayRef) = match &c.data {
+            ColumnData::F64(v) => (DataType::Float64, Arc::new(Float64Array::from(v.clone()))),
+            ColumnData::I64(v) => (DataType::Int64, Arc::new(Int64Array::from(v.clone()))),
+            ColumnData::Str(v) => (DataType::Utf8, Arc::new(StringArray::from(v.clone()))),
+            ColumnData::Bool(v) => (DataType::Boolean, Arc::new(BooleanArray::from(v.clone()))),
+        };
+        let mut md = HashMap::new();
+        if let Some(u) = &c.unit {
+            md.insert("unit".to_string(), u.clone());
+        }
+        if let Some(d) = &c.description {
+            md.insert("description".to_string(), d.clone());
+        }
+        fields.push(Field::new(&c.name, dt, false).with_metadata(md));
+        arrays.push(arr);
+    }
+    // The pairs go both into the Arrow schema (pyarrow/polars show them as `schema.metadata`)
+    // and into the Parquet footer (any Parquet reader).
+    let schema_md: HashMap<String, String> = opts.metadata.iter().cloned().collect();
+    let schema = Arc::new(Schema::new(fields).with_metadata(schema_md));
+    let batch =
+        RecordBatch::try_new(schema.clone(), arrays).map_err(|source| ReportError::Arrow {
+            path: path.to_path_buf(),
+            source,
+        })?;
+    let level = ZstdLevel::try_new(opts.zstd_level).map_err(|source| ReportError::Parquet {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let props = WriterProperties::builder()
+        .set_compression(Compression::ZSTD(level))
+        .set_max_row_group_row_count(Some(opts.row_group_rows.max(1)))
+        .build();
+    let tmp = tmp_path(path);
+    let io = |source| ReportError::Io {
+        path: tmp.clone(),
+        source,
+    };
+    let file = File::create(&tmp).map_err(io)?;
+    let pq = |source| ReportError::Parquet {
+        path: path.to_path_buf(),
+        source,
+    };
+    let result = (|| {
+        let mut w = ArrowWriter::try_new(file, schema, Some(props)).map_err(pq)?;
+        for (k, v) in &opts.metadata {
+            w.append_key_value_metadata(parquet::file::metadata::KeyValue::new(
+                k.clone(),
+                v.clone(),
+            ));
+        }
+        w.write(&batch).map_err(pq)?;
+        let file = w.into_inner().map_err(pq)?;
+        file.sync_all().map_err(io)?;
+        Ok(())
+    })();
+    if let Err(e) = result {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(e);
+    }
+    std::fs::rename(&tmp, path).map_err(|source| ReportError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let bytes = std::fs::metadata(path).map(|m| m.len()).unwrap_or(0);
+    Ok(TableSummary {
+        path: path.to_path_buf(),
+        rows,
+        columns: columns.len(),
+        bytes,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use parquet::file::reader::{FileReader, SerializedFileReader};
+
+    #[test]
+    fn round_trip_with_units_and_metadata() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("t.parquet");
+        let cols = vec![
+            Column::f64("t", "1", vec![0.0, 0.5, 1.0]),
+            Column::new("class", ColumnData::Str(vec!["rest".into(); 3])),
+            Column::new("k", ColumnData::I64(vec![1, 2, 3])),
+            Column::new("ok", ColumnData::Bool(vec![true, false, true])),
+        ];
+        let s = TableOptions::new()
+            .meta("steady_state", "rest")
+            .write(&path, &cols)
+            .unwrap();
+        assert_eq!((s.rows, s.columns), (3, 4));
+        assert!(!dir.path().join(".t.parquet.tmp").exists());
+        let r = SerializedFileReader::new(File::open(&path).unwrap()).unwrap();
+        let kv = r.metadata().file_metadata().key_value_metadata().unwrap();
+        assert!(kv
+            .iter()
+            .any(|k| k.key == "steady_state" && k.value.as_deref() == Some("rest")));
+        let batches: Vec<_> =
+            parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder::try_new(
+                File::open(&path).unwrap(),
+            )
+            .unwrap()
+            .build()
+            .unwrap()
+            .collect::<Result<_, _>>()
+            .unwrap();
+        let b = &batches[0];
+        assert_eq!(
+            b.schema()
+                .field(0)
+                .metadata()
+                .get("unit")
+                .map(String::as_str),
+            Some("1")
+        );
+        let t = b.column(0).as_any().downcast_ref::<Float64Array>().unwrap();
+        assert_eq!(t.values().to_vec(), vec![0.0, 0.5, 1.0]);
+    }
+
+    #[test]
+    fn ragged_columns_are_an_error_and_leave_nothing() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("t.parquet");
+        let cols = vec![
+            Column::f64("a", "1", vec![0.0]),
+            Column::f64("b", "1", vec![]),
+        ];
+        let e = TableOptions::new()
+            .write(&path, &cols)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("\"b\"") && e.contains("expected 1"), "{e}");
+        assert!(std::fs::read_dir(dir.path()).unwrap().next().is_none());
+    }
+}
