@@ -19,7 +19,10 @@ fn every_subcommand_has_help() {
     for c in subcommands {
         let out = run(&[&c, "--help"]);
         assert!(out.status.success(), "{c} --help");
-        assert!(String::from_utf8_lossy(&out.stdout).contains("Usage"), "{c} --help");
+        assert!(
+            String::from_utf8_lossy(&out.stdout).contains("Usage"),
+            "{c} --help"
+        );
     }
 }
 
@@ -30,14 +33,37 @@ fn simulate_writes_parquet_with_steady_state() {
     let out_path = dir.path().join("sim.parquet");
     let out = pendulum()
         .args([
-            "simulate", "--param", "omega=1.585", "--param", "R=0.7", "--param", "lambda=0.126",
-            "--param", "alpha=0", "--param", "beta=0.109", "--param", "M=0.007", "--theta0", "0.5",
-            "--theta-dot0", "0", "--t-end", "300", "--dt-out", "0.05", "--out",
+            "simulate",
+            "--param",
+            "omega=1.585",
+            "--param",
+            "R=0.7",
+            "--param",
+            "lambda=0.126",
+            "--param",
+            "alpha=0",
+            "--param",
+            "beta=0.109",
+            "--param",
+            "M=0.007",
+            "--theta0",
+            "0.5",
+            "--theta-dot0",
+            "0",
+            "--t-end",
+            "300",
+            "--dt-out",
+            "0.05",
+            "--out",
         ])
         .arg(&out_path)
         .output()
         .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let line = String::from_utf8_lossy(&out.stdout);
     assert_eq!(line.lines().count(), 1, "one-line summary: {line}");
 
@@ -55,16 +81,37 @@ fn simulate_writes_parquet_with_steady_state() {
         .collect();
     let class = kv["steady_state"].clone();
     assert!(
-        ["rest", "oscillation", "rotation_ccw", "rotation_cw", "chaos"].contains(&class.as_str()),
+        [
+            "rest",
+            "oscillation",
+            "rotation_ccw",
+            "rotation_cw",
+            "chaos"
+        ]
+        .contains(&class.as_str()),
         "{class}"
     );
     assert!(line.contains(&class), "summary names the class: {line}");
-    let batch = builder.with_batch_size(1 << 20).build().unwrap().next().unwrap().unwrap();
+    let batch = builder
+        .with_batch_size(1 << 20)
+        .build()
+        .unwrap()
+        .next()
+        .unwrap()
+        .unwrap();
     assert_eq!(batch.num_rows(), 6001);
-    let t = batch.column(0).as_any().downcast_ref::<Float64Array>().unwrap();
+    let t = batch
+        .column(0)
+        .as_any()
+        .downcast_ref::<Float64Array>()
+        .unwrap();
     assert_eq!(t.value(0), 0.0);
     assert!((t.value(6000) - 300.0).abs() < 1e-9);
-    let theta = batch.column(1).as_any().downcast_ref::<Float64Array>().unwrap();
+    let theta = batch
+        .column(1)
+        .as_any()
+        .downcast_ref::<Float64Array>()
+        .unwrap();
     assert_eq!(theta.value(0), 0.5);
 
     if python_has("pyarrow") {
@@ -98,7 +145,14 @@ fn bad_parameters_fail_with_a_clear_message() {
 #[test]
 fn demo_prints_the_study_contrast() {
     let out = run(&["demo", "--grid", "2"]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let text = String::from_utf8_lossy(&out.stdout);
-    assert!(text.contains("reference") && text.contains("linear"), "{text}");
+    assert!(
+        text.contains("reference") && text.contains("linear"),
+        "{text}"
+    );
 }

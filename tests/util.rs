@@ -32,7 +32,9 @@ pub fn python_has(module: &str) -> bool {
 
 /// Runs a checker script under tests/python with arguments; panics with its output on failure.
 pub fn python_check(script: &str, args: &[&Path]) {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/python").join(script);
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/python")
+        .join(script);
     let out = Command::new("python3")
         .arg(&path)
         .args(args)

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use pendulum_jobs::{demo, simulate};
+use pendulum_jobs::{demo, ingest, simulate, synth};
 use pendulum_model::SteadyClass;
 
 #[derive(Parser)]
@@ -26,6 +26,30 @@ enum Command {
     Simulate(SimulateArgs),
     /// Run the main job on built-in data.
     Demo(DemoArgs),
+    /// Ingest a campaign's raw captures (serial-v1 CSV, sd-v2 binary) into one MCAP file per run.
+    Ingest(IngestArgs),
+    /// Simulate a campaign with the rig's digital twin: raw captures, campaign.toml, truth.json.
+    Synth(SynthArgs),
+}
+
+#[derive(clap::Args)]
+struct IngestArgs {
+    /// Campaign folder (holding campaign.toml and the captures).
+    campaign_dir: PathBuf,
+    /// Output folder for <run_id>.mcap files.
+    #[arg(long)]
+    out: PathBuf,
+    /// No progress bar.
+    #[arg(long)]
+    quiet: bool,
+}
+
+#[derive(clap::Args)]
+struct SynthArgs {
+    /// Twin case file (rig, truth, sensors, runs).
+    case: PathBuf,
+    /// Output campaign folder.
+    out_dir: PathBuf,
 }
 
 #[derive(clap::Args)]
@@ -93,6 +117,33 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 out: a.out,
             })?;
             println!("{summary}");
+        }
+        Command::Ingest(a) => {
+            let summary = ingest::run(&a.campaign_dir, &a.out, !a.quiet)?;
+            print!("{summary}");
+            let failed = summary.failed();
+            if failed > 0 {
+                anyhow::bail!(
+                    "{failed} of {} runs could not be ingested",
+                    summary.rows.len()
+                );
+            }
+        }
+        Command::Synth(a) => {
+            let s = synth::run(&a.case, &a.out_dir)?;
+            println!(
+                "wrote {} runs to {} (campaign {}, truth {})",
+                s.truth_data.runs.len(),
+                s.dir.display(),
+                s.campaign.display(),
+                s.truth.display()
+            );
+            for r in &s.truth_data.runs {
+                println!(
+                    "  {:<8} {:<6} Ω = {:.5} Hz  t0 = {:.4} s  θ0 = {:+.4} rad  θ̇0 = {:+.4} rad/s  steady {}",
+                    r.id, format!("{:?}", r.format).to_lowercase(), r.omega_real_hz, r.t0_s, r.theta0_rad, r.theta_dot0_rad_s, r.steady
+                );
+            }
         }
         Command::Demo(a) => {
             println!(

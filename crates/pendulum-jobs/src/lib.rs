@@ -3,7 +3,10 @@
 //! of results (progress bars excepted).
 
 pub mod demo;
+pub mod ingest;
+pub mod runs;
 pub mod simulate;
+pub mod synth;
 
 use std::path::PathBuf;
 
@@ -14,6 +17,14 @@ pub enum JobError {
     Model(#[from] pendulum_model::ModelError),
     #[error(transparent)]
     Report(#[from] pendulum_report::ReportError),
+    #[error(transparent)]
+    Rig(#[from] pendulum_rig::RigError),
+    #[error(transparent)]
+    Log(#[from] pendulum_log::LogError),
+    #[error(transparent)]
+    Process(#[from] pendulum_process::ProcessError),
+    #[error(transparent)]
+    Plot(#[from] pendulum_plot::PlotError),
     #[error("{path}: {source}")]
     Io {
         path: PathBuf,

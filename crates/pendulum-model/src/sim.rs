@@ -92,6 +92,16 @@ impl Model {
     }
 }
 
+/// Relative margin by which the applied torque must exceed the static capacity to break loose.
+/// Without it, |Q| = C to rounding gives a slip whose θ̈ has the wrong sign by an ulp, an event at
+/// the segment's start, and no progress (Zeno by round-off).
+const BREAK_MARGIN: f64 = 1e-10;
+
+#[inline]
+fn breaks_loose(q: f64, c: f64) -> bool {
+    q.abs() > c * (1.0 + BREAK_MARGIN) + 1e-14
+}
+
 /// Integrator settings.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -284,16 +294,18 @@ where
             dir = y[1].signum();
         } else {
             let (q, c) = model.static_balance(t, y[0]);
-            if q.abs() <= c {
+            if breaks_loose(q, c) {
+                dir = q.signum();
+            } else {
                 stuck = true;
                 dir = 0.0;
-            } else {
-                dir = q.signum();
             }
         }
     } else {
         dir = 0.0;
     }
+    // Events that made no progress in a row (a guard against Zeno behaviour).
+    let mut idle_events = 0u32;
     let mut h = 1e-2_f64.min(opts.h_max);
     let mut err_old: f64 = 1e-4;
     let mut k1: Y = [0.0; 2];
@@ -483,14 +495,24 @@ where
                     break;
                 }
             }
+            idle_events = if te - t <= 1e-12 * t.abs().max(1.0) {
+                idle_events + 1
+            } else {
+                0
+            };
             t = te;
             y = ye;
             let (q, c) = model.static_balance(t, y[0]);
-            if q.abs() <= c {
+            if breaks_loose(q, c) && idle_events < 3 {
+                dir = q.signum();
+            } else {
                 stuck = true;
                 dir = 0.0;
-            } else {
-                dir = q.signum();
+                if idle_events >= 3 {
+                    // Balanced on the edge of the friction cone: hold still for a moment.
+                    t += 1e-9 * t.abs().max(1.0);
+                    idle_events = 0;
+                }
             }
             need_k1 = true;
             h = h_next.min(h);
@@ -570,7 +592,7 @@ fn locate_zero(dense: &Dense, a: f64, b: f64, dir: f64) -> f64 {
 fn find_breakaway(model: &Model, t: f64, theta: f64, t_end: f64) -> Option<f64> {
     let excess = |tt: f64| {
         let (q, c) = model.static_balance(tt, theta);
-        q.abs() - c
+        q.abs() - (c * (1.0 + BREAK_MARGIN) + 1e-14)
     };
     // Scan finely enough for the forcing (64 points per period) and the measured signal's grid.
     let mut h = match &model.excitation {

@@ -72,7 +72,9 @@ impl FromStr for SteadyClass {
 pub struct SteadyState {
     pub class: SteadyClass,
     pub period: u32,
-    /// Mean θ̇ over the recorded section (dimensionless); the rotation speed for rotations.
+    /// Mean θ̇ over the recorded section, in the time unit of the history (dimensionless for
+    /// simulations); the rotation speed for rotations, 0 for rest and oscillation.
+    /// [`classify_poincare`] alone, knowing no period, gives it per Poincaré step.
     pub mean_theta_dot: f64,
 }
 
@@ -206,7 +208,9 @@ pub fn steady_state_of(
         ControlFlow::Continue(())
     })?;
     let _ = stats;
-    Ok((classify_poincare(&th, &thd, copts), th, thd))
+    let mut s = classify_poincare(&th, &thd, copts);
+    s.mean_theta_dot /= period;
+    Ok((s, th, thd))
 }
 
 /// Classifies a sampled θ(t) history — simulated or measured — without θ̇: samples θ at one
@@ -250,7 +254,9 @@ pub fn classify_history(
             "history from t={t_from} holds fewer than 2 forcing periods of {period}"
         )));
     }
-    Ok(classify_poincare(&a, &b, opts))
+    let mut s = classify_poincare(&a, &b, opts);
+    s.mean_theta_dot /= period;
+    Ok(s)
 }
 
 #[cfg(test)]

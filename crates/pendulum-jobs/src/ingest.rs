@@ -1,0 +1,247 @@
+//! `pendulum ingest CAMPAIGN_DIR --out OUT_DIR`: every run's raw capture → one `<run_id>.mcap`,
+//! in parallel, streaming (constant memory in the capture's length), atomically.
+
+use std::path::{Path, PathBuf};
+
+use indicatif::{ProgressBar, ProgressStyle};
+use pendulum_log::{
+    parse_rfc3339_utc_ns, AccelMsg, EncoderMsg, RunLogOptions, METADATA_CAPTURE_HEADER,
+    METADATA_RUN,
+};
+use pendulum_rig::{Campaign, CaptureReader, IngestStats, ReadOptions, RunSpec, Sample};
+use rayon::prelude::*;
+
+use crate::runs::run_metadata;
+use crate::JobError;
+
+/// One run's ingest result.
+#[derive(Debug, Clone)]
+pub struct IngestRow {
+    pub run_id: String,
+    pub format: String,
+    pub mcap: Option<PathBuf>,
+    pub stats: Option<IngestStats>,
+    /// Why the run could not be ingested at all.
+    pub error: Option<String>,
+    pub warnings: Vec<String>,
+}
+
+/// All runs' results.
+#[derive(Debug, Clone)]
+pub struct IngestSummary {
+    pub campaign: String,
+    pub rows: Vec<IngestRow>,
+}
+
+impl IngestSummary {
+    /// Runs that could not be ingested at all.
+    pub fn failed(&self) -> usize {
+        self.rows.iter().filter(|r| r.error.is_some()).count()
+    }
+}
+
+impl std::fmt::Display for IngestSummary {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        writeln!(f, "campaign {}: {} runs", self.campaign, self.rows.len())?;
+        writeln!(
+            f,
+            "{:<10} {:<10} {:>9} {:>8} {:>8} {:>8} {:>5} {:>6} {:>6} {:>6}",
+            "run",
+            "format",
+            "encoder",
+            "accel",
+            "skipped",
+            "bytes",
+            "gaps",
+            "clkwr",
+            "encwr",
+            "trunc"
+        )?;
+        for r in &self.rows {
+            match (&r.stats, &r.error) {
+                (Some(s), None) => writeln!(
+                    f,
+                    "{:<10} {:<10} {:>9} {:>8} {:>8} {:>8} {:>5} {:>6} {:>6} {:>6}",
+                    r.run_id,
+                    r.format,
+                    s.encoder_samples,
+                    s.accel_samples,
+                    s.skipped_lines_or_frames,
+                    s.skipped_bytes,
+                    s.gap_count,
+                    s.clock_wraps,
+                    s.encoder_wraps,
+                    s.truncated_tail_bytes
+                )?,
+                (_, Some(e)) => writeln!(f, "{:<10} FAILED: {e}", r.run_id)?,
+                _ => {}
+            }
+        }
+        for r in &self.rows {
+            if let Some(s) = &r.stats {
+                for skip in &s.skips {
+                    writeln!(f, "  {}: skipped at {}: {}", r.run_id, skip.at, skip.reason)?;
+                }
+                let more = s
+                    .skipped_lines_or_frames
+                    .saturating_sub(s.skips.len() as u64);
+                if more > 0 {
+                    writeln!(f, "  {}: … and {more} more skipped", r.run_id)?;
+                }
+                for g in s.gaps.iter().take(3) {
+                    writeln!(
+                        f,
+                        "  {}: gap in {} from t_us {} to {} (~{} samples missing)",
+                        r.run_id, g.stream, g.after_t_us, g.before_t_us, g.missing_samples_est
+                    )?;
+                }
+            }
+            for w in &r.warnings {
+                writeln!(f, "  {}: warning: {w}", r.run_id)?;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Smallest unwrapped clock value among the first samples (frames of the two SD streams may be
+/// slightly out of order), so that every t_s is ≥ 0.
+fn first_t_us(spec: &RunSpec, opts: ReadOptions) -> Result<Option<u64>, JobError> {
+    let mut r = CaptureReader::open(&spec.file, opts)?;
+    let mut min: Option<u64> = None;
+    for _ in 0..2000 {
+        match r.next_sample()? {
+            Some(s) => min = Some(min.map_or(s.t_us(), |m| m.min(s.t_us()))),
+            None => break,
+        }
+    }
+    Ok(min)
+}
+
+fn ingest_run(c: &Campaign, spec: &RunSpec, out_dir: &Path) -> Result<IngestRow, JobError> {
+    let opts = ReadOptions {
+        g_m_s2: c.g_m_s2,
+        ..ReadOptions::default()
+    };
+    let t0 = first_t_us(spec, opts)?.unwrap_or(0);
+    let mut reader = CaptureReader::open(&spec.file, opts)?;
+    let mut warnings = Vec::new();
+    let start_ns = match reader.header().started() {
+        Some(s) => match parse_rfc3339_utc_ns(s) {
+            Ok(ns) => Some(ns),
+            Err(e) => {
+                warnings.push(format!(
+                    "header started={s:?} unreadable ({e}); log times use the board clock"
+                ));
+                None
+            }
+        },
+        None => None,
+    };
+    let path = out_dir.join(format!("{}.mcap", spec.id));
+    let mut w = RunLogOptions::new()
+        .library(concat!("pendulum/", env!("CARGO_PKG_VERSION")))
+        .start_ns(start_ns)
+        .create(&path)?;
+    w.write_metadata(METADATA_RUN, run_metadata(c, spec))?;
+    w.write_metadata(
+        METADATA_CAPTURE_HEADER,
+        reader.header().entries.iter().cloned().collect(),
+    )?;
+    while let Some(s) = reader.next_sample()? {
+        let t_us = s.t_us();
+        if t_us < t0 {
+            warnings.push(format!(
+                "sample at t_us {t_us} precedes the capture's first sample: dropped"
+            ));
+            continue;
+        }
+        let t_s = (t_us - t0) as f64 * 1e-6;
+        match s {
+            Sample::Encoder(e) => w.write_encoder(&EncoderMsg {
+                t_s,
+                t_us,
+                count: e.count,
+                count_raw: e.count_raw,
+                theta_rad: e.theta_rad,
+            })?,
+            Sample::Accel(a) => w.write_accel(&AccelMsg {
+                t_s,
+                t_us,
+                ax_raw: a.raw[0],
+                ay_raw: a.raw[1],
+                az_raw: a.raw[2],
+                ax_m_s2: a.si_m_s2[0],
+                ay_m_s2: a.si_m_s2[1],
+                az_m_s2: a.si_m_s2[2],
+            })?,
+        }
+    }
+    let stats = reader.stats().clone();
+    let mut json = serde_json::to_value(&stats).unwrap_or_default();
+    if let Some(o) = json.as_object_mut() {
+        o.insert("format".into(), reader.format().into());
+    }
+    w.write_stats(&json)?;
+    let summary = w.finish()?;
+    Ok(IngestRow {
+        run_id: spec.id.clone(),
+        format: reader.format().to_string(),
+        mcap: Some(summary.path),
+        stats: Some(stats),
+        error: None,
+        warnings,
+    })
+}
+
+/// Ingests every run of the campaign at `dir` into `out_dir`.
+pub fn run(dir: &Path, out_dir: &Path, show_progress: bool) -> Result<IngestSummary, JobError> {
+    let c = Campaign::load(dir)?;
+    std::fs::create_dir_all(out_dir).map_err(|source| JobError::Io {
+        path: out_dir.to_path_buf(),
+        source,
+    })?;
+    let bar = if show_progress {
+        let b = ProgressBar::new(c.runs.len() as u64);
+        b.set_style(
+            ProgressStyle::with_template("ingest {bar:30} {pos}/{len} runs {msg}")
+                .unwrap_or_else(|_| ProgressStyle::default_bar()),
+        );
+        b
+    } else {
+        ProgressBar::hidden()
+    };
+    let rows: Vec<IngestRow> = c
+        .runs
+        .par_iter()
+        .map(|spec| {
+            let row = if !spec.file.is_file() {
+                IngestRow {
+                    run_id: spec.id.clone(),
+                    format: "-".into(),
+                    mcap: None,
+                    stats: None,
+                    error: Some(format!("{}: capture file not found", spec.file.display())),
+                    warnings: Vec::new(),
+                }
+            } else {
+                ingest_run(&c, spec, out_dir).unwrap_or_else(|e| IngestRow {
+                    run_id: spec.id.clone(),
+                    format: "-".into(),
+                    mcap: None,
+                    stats: None,
+                    error: Some(e.to_string()),
+                    warnings: Vec::new(),
+                })
+            };
+            bar.set_message(spec.id.clone());
+            bar.inc(1);
+            row
+        })
+        .collect();
+    bar.finish_and_clear();
+    Ok(IngestSummary {
+        campaign: c.name.clone(),
+        rows,
+    })
+}

@@ -1,0 +1,229 @@
+//! Loading runs for the stages: from a campaign folder (raw captures, read on the fly) or from a
+//! folder of MCAP files written by `pendulum ingest` (metadata record `run` holds the campaign's
+//! description). Either way the stages get the same [`RunData`].
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use pendulum_log::{read_run, RunLog, METADATA_RUN};
+use pendulum_process::{RigParams, Role, RunData};
+use pendulum_rig::{Campaign, CaptureReader, IngestStats, ReadOptions, RunSpec, Sample};
+
+use crate::JobError;
+
+/// A capture read into memory, with what the reader found.
+pub struct ReadCapture {
+    pub format: &'static str,
+    pub header: Vec<(String, String)>,
+    pub stats: IngestStats,
+    pub samples: Vec<Sample>,
+}
+
+/// Reads every sample of a run's capture (streaming reader; the samples are kept).
+pub fn read_capture(spec: &RunSpec, g_m_s2: f64) -> Result<ReadCapture, JobError> {
+    let opts = ReadOptions {
+        g_m_s2,
+        ..ReadOptions::default()
+    };
+    let mut reader = CaptureReader::open(&spec.file, opts)?;
+    let mut samples = Vec::new();
+    while let Some(s) = reader.next_sample()? {
+        samples.push(s);
+    }
+    Ok(ReadCapture {
+        format: reader.format(),
+        header: reader.header().entries.clone(),
+        stats: reader.stats().clone(),
+        samples,
+    })
+}
+
+/// The campaign's description of a run as flat strings (the MCAP metadata record `run`).
+pub fn run_metadata(c: &Campaign, spec: &RunSpec) -> BTreeMap<String, String> {
+    let mut m = BTreeMap::new();
+    m.insert("campaign".into(), c.name.clone());
+    m.insert("id".into(), spec.id.clone());
+    m.insert(
+        "file".into(),
+        spec.file
+            .file_name()
+            .map(|f| f.to_string_lossy().into_owned())
+            .unwrap_or_default(),
+    );
+    m.insert("role".into(), spec.role.as_str().into());
+    m.insert("m_kg".into(), spec.m_kg.to_string());
+    m.insert("l_m".into(), spec.l_m.to_string());
+    m.insert("crank_r_m".into(), spec.crank_r_m.to_string());
+    m.insert("rod_L_m".into(), spec.rod_l_m.to_string());
+    m.insert("r_b_m".into(), spec.r_b_m.to_string());
+    m.insert("g_m_s2".into(), c.g_m_s2.to_string());
+    if let Some(w) = spec.omega_hz {
+        m.insert("omega_hz".into(), w.to_string());
+    }
+    if let Some(f) = &spec.format {
+        m.insert("format".into(), f.clone());
+    }
+    for (k, v) in &spec.extra {
+        let text = match v {
+            toml::Value::String(s) => s.clone(),
+            other => other.to_string(),
+        };
+        m.insert(k.clone(), text);
+    }
+    m
+}
+
+fn role_of(r: pendulum_rig::Role) -> Role {
+    match r {
+        pendulum_rig::Role::Identify => Role::Identify,
+        pendulum_rig::Role::Validate => Role::Validate,
+    }
+}
+
+/// Converts a read capture into the stages' run data (times in s from the first sample).
+pub fn run_data(c: &Campaign, spec: &RunSpec, cap: &ReadCapture) -> RunData {
+    let t_first = cap.samples.iter().map(|s| s.t_us()).min().unwrap_or(0);
+    let mut rd = RunData {
+        id: spec.id.clone(),
+        role: role_of(spec.role),
+        rig: RigParams {
+            m_kg: spec.m_kg,
+            l_m: spec.l_m,
+            crank_r_m: spec.crank_r_m,
+            rod_l_m: spec.rod_l_m,
+            r_b_m: spec.r_b_m,
+            omega_hz: spec.omega_hz,
+            g_m_s2: c.g_m_s2,
+        },
+        enc_t_s: Vec::new(),
+        theta_rad: Vec::new(),
+        acc_t_s: Vec::new(),
+        az_m_s2: Vec::new(),
+        ax_m_s2: Vec::new(),
+    };
+    for s in &cap.samples {
+        match s {
+            Sample::Encoder(e) => {
+                rd.enc_t_s.push((e.t_us - t_first) as f64 * 1e-6);
+                rd.theta_rad.push(e.theta_rad);
+            }
+            Sample::Accel(a) => {
+                rd.acc_t_s.push((a.t_us - t_first) as f64 * 1e-6);
+                rd.ax_m_s2.push(a.si_m_s2[0]);
+                rd.az_m_s2.push(a.si_m_s2[2]);
+            }
+        }
+    }
+    rd
+}
+
+fn meta_f64(m: &BTreeMap<String, String>, key: &str, path: &Path) -> Result<f64, JobError> {
+    let v = m.get(key).ok_or_else(|| {
+        JobError::Invalid(format!(
+            "{}: metadata record `run` lacks key {key}",
+            path.display()
+        ))
+    })?;
+    v.parse().map_err(|_| {
+        JobError::Invalid(format!(
+            "{}: metadata `run.{key}` = {v:?} is not a number",
+            path.display()
+        ))
+    })
+}
+
+/// Converts an MCAP run log (written by `pendulum ingest`) into the stages' run data.
+pub fn run_data_from_log(log: &RunLog) -> Result<RunData, JobError> {
+    let path = &log.path;
+    let m = log.metadata.get(METADATA_RUN).ok_or_else(|| {
+        JobError::Invalid(format!(
+            "{}: no metadata record `run`: not written by pendulum ingest?",
+            path.display()
+        ))
+    })?;
+    let role = match m.get("role").map(String::as_str) {
+        Some("identify") => Role::Identify,
+        Some("validate") => Role::Validate,
+        other => {
+            return Err(JobError::Invalid(format!(
+                "{}: metadata `run.role` = {other:?}: expected identify or validate",
+                path.display()
+            )))
+        }
+    };
+    Ok(RunData {
+        id: m
+            .get("id")
+            .cloned()
+            .unwrap_or_else(|| path.display().to_string()),
+        role,
+        rig: RigParams {
+            m_kg: meta_f64(m, "m_kg", path)?,
+            l_m: meta_f64(m, "l_m", path)?,
+            crank_r_m: meta_f64(m, "crank_r_m", path)?,
+            rod_l_m: meta_f64(m, "rod_L_m", path)?,
+            r_b_m: meta_f64(m, "r_b_m", path)?,
+            omega_hz: m
+                .get("omega_hz")
+                .map(|_| meta_f64(m, "omega_hz", path))
+                .transpose()?,
+            g_m_s2: meta_f64(m, "g_m_s2", path)?,
+        },
+        enc_t_s: log.encoder.iter().map(|e| e.t_s).collect(),
+        theta_rad: log.encoder.iter().map(|e| e.theta_rad).collect(),
+        acc_t_s: log.accel.iter().map(|a| a.t_s).collect(),
+        az_m_s2: log.accel.iter().map(|a| a.az_m_s2).collect(),
+        ax_m_s2: log.accel.iter().map(|a| a.ax_m_s2).collect(),
+    })
+}
+
+/// Where runs come from.
+pub enum Source {
+    Campaign(Campaign),
+    Mcap(Vec<PathBuf>),
+}
+
+/// Decides whether `dir` is a campaign (has campaign.toml) or a folder of MCAP files.
+pub fn source(dir: &Path) -> Result<Source, JobError> {
+    if dir.join("campaign.toml").is_file() || dir.extension().is_some_and(|e| e == "toml") {
+        let c = Campaign::load(dir)?;
+        c.check_files()?;
+        return Ok(Source::Campaign(c));
+    }
+    let rd = std::fs::read_dir(dir).map_err(|source| JobError::Io {
+        path: dir.to_path_buf(),
+        source,
+    })?;
+    let mut files: Vec<PathBuf> = rd
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|e| e == "mcap"))
+        .filter(|p| {
+            !p.file_name()
+                .is_some_and(|n| n.to_string_lossy().starts_with('.'))
+        })
+        .collect();
+    files.sort();
+    if files.is_empty() {
+        return Err(JobError::Invalid(format!(
+            "{}: neither a campaign (no campaign.toml) nor a folder of .mcap run logs",
+            dir.display()
+        )));
+    }
+    Ok(Source::Mcap(files))
+}
+
+/// Loads every run of a campaign or MCAP folder (in parallel).
+pub fn load_runs(dir: &Path) -> Result<Vec<RunData>, JobError> {
+    use rayon::prelude::*;
+    match source(dir)? {
+        Source::Campaign(c) => c
+            .runs
+            .par_iter()
+            .map(|spec| read_capture(spec, c.g_m_s2).map(|cap| run_data(&c, spec, &cap)))
+            .collect(),
+        Source::Mcap(files) => files
+            .par_iter()
+            .map(|p| run_data_from_log(&read_run(p)?))
+            .collect(),
+    }
+}

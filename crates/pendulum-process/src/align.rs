@@ -1,0 +1,315 @@
+//! Alignment: where the shaker starts, where it is at speed, the real crank speed and phase from a
+//! least-squares fit of the exact crank-rod acceleration to the accelerometer, and t = 0 at the
+//! first positive acceleration peak at speed (the study's convention).
+//!
+//! Method: (1) the shaker start is where the vertical signal's short-time RMS leaves the quiet
+//! level of the free segment; (2) on a window safely at speed, a coarse search of the fundamental's
+//! power over speeds near the set point gives Ω and the phase; (3) Gauss–Newton on
+//! a_z = c0 + G·r(2πΩ)²·f''(2πΩ(t − t_p)) refines (c0, G, Ω, t_p) and gives their covariance;
+//! (4) walking back peak by peak from the window, the earliest peak from which every cycle carries
+//! at least `at_speed_fraction` of the fitted amplitude is t = 0.
+
+use pendulum_model::excitation::crank_f2;
+use serde::{Deserialize, Serialize};
+
+use crate::linalg::{inverse, solve};
+use crate::run::RunData;
+use crate::ProcessError;
+
+/// Alignment settings.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct AlignConfig {
+    /// Length of the at-speed window the crank model is fitted on, s.
+    pub fit_window_s: f64,
+    /// Quiet reference at the start of the capture (shaker off), s.
+    pub quiet_s: f64,
+    /// A cycle is at speed when its amplitude is at least this fraction of the fitted one.
+    pub at_speed_fraction: f64,
+    /// Relative range of real speeds searched around the set point.
+    pub speed_search: f64,
+    /// Crank turns after the detected start before the fit window begins.
+    pub settle_turns: f64,
+}
+
+impl Default for AlignConfig {
+    fn default() -> Self {
+        Self {
+            fit_window_s: 20.0,
+            quiet_s: 1.0,
+            at_speed_fraction: 0.9,
+            speed_search: 0.02,
+            settle_turns: 3.0,
+        }
+    }
+}
+
+impl AlignConfig {
+    pub fn validate(&self) -> Result<(), ProcessError> {
+        let checks = [
+            ("fit_window_s", self.fit_window_s, self.fit_window_s > 0.0),
+            ("quiet_s", self.quiet_s, self.quiet_s > 0.0),
+            (
+                "at_speed_fraction",
+                self.at_speed_fraction,
+                self.at_speed_fraction > 0.0 && self.at_speed_fraction < 1.0,
+            ),
+            (
+                "speed_search",
+                self.speed_search,
+                self.speed_search > 0.0 && self.speed_search < 0.5,
+            ),
+            ("settle_turns", self.settle_turns, self.settle_turns >= 0.0),
+        ];
+        for (field, value, ok) in checks {
+            if !(ok && value.is_finite()) {
+                return Err(ProcessError::BadConfig {
+                    stage: "align".into(),
+                    field: field.into(),
+                    message: format!("{value} is out of range"),
+                });
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Where a run's forced motion starts and how its crank turns.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Alignment {
+    /// Detected shaker start, s since the first sample.
+    pub shaker_start_s: f64,
+    /// The free-motion segment [start, end] before the shaker (a free decay), s.
+    pub free_segment_s: (f64, f64),
+    /// t = 0: the first positive acceleration peak at speed, s since the first sample.
+    pub t0_s: f64,
+    /// Its standard uncertainty, s.
+    pub t0_sigma_s: f64,
+    /// Real crank speed, Hz, and its standard uncertainty.
+    pub omega_hz: f64,
+    pub omega_sigma_hz: f64,
+    /// Fitted amplitude over the nominal r(2πΩ)² (accelerometer gain × geometry), –.
+    pub accel_gain: f64,
+    /// Fitted vertical offset (g plus the sensor's zero-g offset), m/s².
+    pub az_offset_m_s2: f64,
+    /// RMS of the fit's residual, m/s².
+    pub residual_rms_m_s2: f64,
+    /// The window the crank model was fitted on, s.
+    pub fit_window_s: (f64, f64),
+}
+
+fn f3(phi: f64, lambda: f64) -> f64 {
+    let h = 1e-5;
+    (crank_f2(phi + h, lambda) - crank_f2(phi - h, lambda)) / (2.0 * h)
+}
+
+fn median(v: &mut [f64]) -> f64 {
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    if n == 0 {
+        return f64::NAN;
+    }
+    if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    }
+}
+
+/// Aligns one run (see the module docs).
+pub fn align(run: &RunData, cfg: &AlignConfig) -> Result<Alignment, ProcessError> {
+    cfg.validate()?;
+    let fail = |reason: String| ProcessError::Align {
+        run: run.id.clone(),
+        reason,
+    };
+    let omega_set = run
+        .rig
+        .omega_hz
+        .ok_or_else(|| fail("the campaign gives no omega_hz: no shaker to align to".into()))?;
+    let (t, az) = (&run.acc_t_s, &run.az_m_s2);
+    if t.len() < 50 {
+        return Err(fail(format!("only {} accelerometer samples", t.len())));
+    }
+    let r = run.rig.crank_r_m;
+    let lambda = r / run.rig.rod_l_m;
+    let two_pi = 2.0 * std::f64::consts::PI;
+    let expected_amp = r * (two_pi * omega_set).powi(2) * (1.0 + lambda);
+
+    // (1) Shaker start: short-time RMS about the quiet level.
+    let quiet_end = t[0] + cfg.quiet_s;
+    let mut quiet: Vec<f64> = t
+        .iter()
+        .zip(az)
+        .filter(|(tt, _)| **tt < quiet_end)
+        .map(|(_, a)| *a)
+        .collect();
+    if quiet.len() < 10 {
+        return Err(fail(format!(
+            "fewer than 10 accelerometer samples in the first {} s",
+            cfg.quiet_s
+        )));
+    }
+    let level = median(&mut quiet.clone());
+    let mut dev: Vec<f64> = quiet.iter_mut().map(|a| (*a - level).abs()).collect();
+    let sigma_q = 1.4826 * median(&mut dev);
+    let threshold = (8.0 * sigma_q).max(0.05 * expected_amp);
+    let win = 0.1;
+    let mut start = None;
+    let mut j0 = 0;
+    let mut acc = 0.0;
+    for i in 0..t.len() {
+        acc += (az[i] - level).powi(2);
+        while t[i] - t[j0] > win {
+            acc -= (az[j0] - level).powi(2);
+            j0 += 1;
+        }
+        let n = (i - j0 + 1) as f64;
+        if n >= 5.0 && (acc / n).sqrt() > threshold {
+            start = Some(t[j0]);
+            break;
+        }
+    }
+    let shaker_start_s = start.ok_or_else(|| {
+        fail(format!(
+            "the vertical acceleration never leaves its quiet level {level:.3} m/s² by more than {threshold:.3} m/s² RMS: did the shaker run?"
+        ))
+    })?;
+
+    // (2) Coarse speed and phase on a window safely at speed.
+    let w_start = shaker_start_s + cfg.settle_turns / omega_set;
+    let w_end = (w_start + cfg.fit_window_s).min(t[t.len() - 1]);
+    if w_end - w_start < 5.0 / omega_set {
+        return Err(fail(format!(
+            "fewer than 5 crank turns at speed after the shaker start at {shaker_start_s:.3} s"
+        )));
+    }
+    let idx: Vec<usize> = (0..t.len())
+        .filter(|&i| t[i] >= w_start && t[i] <= w_end)
+        .collect();
+    let t_mid = 0.5 * (w_start + w_end);
+    let mean_az = idx.iter().map(|&i| az[i]).sum::<f64>() / idx.len() as f64;
+    let step = 0.2 / (two_pi * (w_end - w_start)); // ≤ 0.2 rad of phase drift across the window
+    let n_steps = ((cfg.speed_search * omega_set) / step).ceil() as i64;
+    let mut best = (0.0, omega_set, 0.0);
+    for k in -n_steps..=n_steps {
+        let om = omega_set + k as f64 * step;
+        let (mut c, mut s) = (0.0, 0.0);
+        for &i in &idx {
+            let ph = two_pi * om * (t[i] - t_mid);
+            c += (az[i] - mean_az) * ph.cos();
+            s += (az[i] - mean_az) * ph.sin();
+        }
+        let p = c * c + s * s;
+        if p > best.0 {
+            best = (p, om, s.atan2(c));
+        }
+    }
+    // Fundamental ∝ cos(2πΩ(t − t_mid) − ψ): its peak (φ = 0) is at t_mid + ψ/(2πΩ).
+    let mut p = [mean_az, 1.0, best.1, best.2 / (two_pi * best.1)];
+
+    // (3) Gauss–Newton on (c0, G, Ω, t_p − t_mid).
+    let model = |p: &[f64; 4], ti: f64| -> (f64, [f64; 4]) {
+        let (c0, g, om, tp) = (p[0], p[1], p[2], p[3]);
+        let kk = r * (two_pi * om).powi(2);
+        let dt = ti - t_mid - tp;
+        let phi = two_pi * om * dt;
+        let f2 = crank_f2(phi, lambda);
+        let d3 = f3(phi, lambda);
+        let val = c0 + g * kk * f2;
+        let j = [
+            1.0,
+            kk * f2,
+            g * (2.0 * kk / om * f2 + kk * d3 * two_pi * dt),
+            -g * kk * d3 * two_pi * om,
+        ];
+        (val, j)
+    };
+    let mut cov = [0.0; 16];
+    let mut rms = 0.0;
+    for iter in 0..30 {
+        let mut jtj = [0.0; 16];
+        let mut jtr = [0.0; 4];
+        let mut ss = 0.0;
+        for &i in &idx {
+            let (v, j) = model(&p, t[i]);
+            let res = az[i] - v;
+            ss += res * res;
+            for a in 0..4 {
+                jtr[a] += j[a] * res;
+                for b in 0..4 {
+                    jtj[a * 4 + b] += j[a] * j[b];
+                }
+            }
+        }
+        let n = idx.len() as f64;
+        rms = (ss / n).sqrt();
+        let delta =
+            solve(&jtj, &jtr, 4).ok_or_else(|| fail("the crank-model fit is singular".into()))?;
+        let s2 = ss / (n - 4.0).max(1.0);
+        if let Some(inv) = inverse(&jtj, 4) {
+            for (c, v) in cov.iter_mut().zip(inv) {
+                *c = v * s2;
+            }
+        }
+        for a in 0..4 {
+            p[a] += delta[a];
+        }
+        let small = delta[2].abs() < 1e-12 * p[2] && delta[3].abs() < 1e-10;
+        if small && iter > 1 {
+            break;
+        }
+    }
+    if !(p[1] > 0.0 && p[2] > 0.0) {
+        return Err(fail(format!(
+            "the crank-model fit diverged (gain {}, speed {} Hz)",
+            p[1], p[2]
+        )));
+    }
+    let (c0, gain, omega, tp) = (p[0], p[1], p[2], p[3] + t_mid);
+    let period = 1.0 / omega;
+
+    // (4) Walk back from the first peak in the window while cycles carry the full amplitude.
+    let kk = r * (two_pi * omega).powi(2);
+    let cycle_gain = |tc: f64| -> Option<f64> {
+        let lo = t.partition_point(|&x| x < tc - 0.5 * period);
+        let hi = t.partition_point(|&x| x < tc + 0.5 * period);
+        if hi - lo < 8 {
+            return None;
+        }
+        let (mut num, mut den) = (0.0, 0.0);
+        for i in lo..hi {
+            let basis = kk * crank_f2(two_pi * omega * (t[i] - tp), lambda);
+            num += (az[i] - c0) * basis;
+            den += basis * basis;
+        }
+        Some(num / den)
+    };
+    let mut k = ((w_start - tp) / period).ceil();
+    loop {
+        let prev = tp + (k - 1.0) * period;
+        if prev - 0.5 * period < shaker_start_s - period {
+            break;
+        }
+        match cycle_gain(prev) {
+            Some(g) if g >= cfg.at_speed_fraction * gain => k -= 1.0,
+            _ => break,
+        }
+    }
+    let t0_s = tp + k * period;
+    // t0 = t_p + k/Ω: propagate the covariance of (Ω, t_p).
+    let d_om = -k / (omega * omega);
+    let var = cov[3 * 4 + 3] + d_om * d_om * cov[2 * 4 + 2] + 2.0 * d_om * cov[2 * 4 + 3];
+    Ok(Alignment {
+        shaker_start_s,
+        free_segment_s: (t[0], (shaker_start_s - 0.05).max(t[0])),
+        t0_s,
+        t0_sigma_s: var.max(0.0).sqrt(),
+        omega_hz: omega,
+        omega_sigma_hz: cov[2 * 4 + 2].max(0.0).sqrt(),
+        accel_gain: gain,
+        az_offset_m_s2: c0,
+        residual_rms_m_s2: rms,
+        fit_window_s: (w_start, w_end),
+    })
+}

@@ -1,0 +1,158 @@
+//! Initial conditions at t = 0 from the encoder: a local polynomial fit (not a two-point
+//! difference, which would amplify the encoder's quantisation), with uncertainties; and the
+//! encoder zero checked against the hanging position from the free decay's turning points.
+
+use serde::{Deserialize, Serialize};
+
+use crate::linalg::lstsq;
+use crate::run::RunData;
+use crate::ProcessError;
+
+/// Initial-condition settings.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct IcConfig {
+    /// Half-width of the fitted window around t = 0, s.
+    pub half_window_s: f64,
+    /// Polynomial order (2–5).
+    pub order: usize,
+}
+
+impl Default for IcConfig {
+    fn default() -> Self {
+        Self {
+            half_window_s: 0.06,
+            order: 3,
+        }
+    }
+}
+
+impl IcConfig {
+    pub fn validate(&self) -> Result<(), ProcessError> {
+        if !(self.half_window_s > 0.0 && self.half_window_s < 1.0) {
+            return Err(ProcessError::BadConfig {
+                stage: "initial_conditions".into(),
+                field: "half_window_s".into(),
+                message: format!("{} is not in (0, 1) s", self.half_window_s),
+            });
+        }
+        if !(2..=5).contains(&self.order) {
+            return Err(ProcessError::BadConfig {
+                stage: "initial_conditions".into(),
+                field: "order".into(),
+                message: format!("{} is not in 2..=5", self.order),
+            });
+        }
+        Ok(())
+    }
+}
+
+/// θ and θ̇ at a time, with standard uncertainties.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct InitialState {
+    pub theta_rad: f64,
+    pub theta_sigma_rad: f64,
+    pub theta_dot_rad_s: f64,
+    pub theta_dot_sigma_rad_s: f64,
+}
+
+/// Local polynomial estimate of θ, θ̇ at `t_s`.
+pub fn estimate_state(
+    run: &RunData,
+    t_s: f64,
+    cfg: &IcConfig,
+) -> Result<InitialState, ProcessError> {
+    cfg.validate()?;
+    let (t, th) = (&run.enc_t_s, &run.theta_rad);
+    let lo = t.partition_point(|&x| x < t_s - cfg.half_window_s);
+    let hi = t.partition_point(|&x| x <= t_s + cfg.half_window_s);
+    if hi - lo < cfg.order + 3 {
+        return Err(ProcessError::Run {
+            run: run.id.clone(),
+            reason: format!(
+                "only {} encoder samples within ±{} s of t = {t_s:.4} s; need {} for an order-{} fit",
+                hi - lo,
+                cfg.half_window_s,
+                cfg.order + 3,
+                cfg.order
+            ),
+        });
+    }
+    let rows: Vec<Vec<f64>> = (lo..hi)
+        .map(|i| {
+            let x = (t[i] - t_s) / cfg.half_window_s;
+            (0..=cfg.order).map(|p| x.powi(p as i32)).collect()
+        })
+        .collect();
+    let (b, cov, _) = lstsq(&rows, &th[lo..hi]).ok_or_else(|| ProcessError::Run {
+        run: run.id.clone(),
+        reason: format!("singular initial-condition fit at t = {t_s:.4} s"),
+    })?;
+    let n = cfg.order + 1;
+    // Quantisation (uniform, 2π/4096) is a floor on the residual variance.
+    let q2 = (2.0 * std::f64::consts::PI / 4096.0).powi(2) / 12.0;
+    let s0 = cov[0].max(q2 / (hi - lo) as f64).sqrt();
+    Ok(InitialState {
+        theta_rad: b[0],
+        theta_sigma_rad: s0,
+        theta_dot_rad_s: b[1] / cfg.half_window_s,
+        theta_dot_sigma_rad_s: cov[n + 1].max(0.0).sqrt() / cfg.half_window_s,
+    })
+}
+
+/// Hanging position from a free decay's turning points in [t_from, t_to]: the median of
+/// (e_i + 2 e_{i+1} + e_{i+2})/4 over successive extrema, which cancels a linearly shrinking
+/// amplitude (dry friction) as well as a slowly shrinking one. `None` when there are fewer than
+/// three swings or the pendulum turns over.
+pub fn hanging_position(run: &RunData, t_from: f64, t_to: f64) -> Option<f64> {
+    let (t, th) = (&run.enc_t_s, &run.theta_rad);
+    let lo = t.partition_point(|&x| x < t_from);
+    let hi = t.partition_point(|&x| x <= t_to);
+    if hi < lo + 20 {
+        return None;
+    }
+    let seg = &th[lo..hi];
+    if seg.iter().any(|x| x.abs() > std::f64::consts::PI) {
+        return None;
+    }
+    // Smooth over ±5 samples so that quantisation steps do not make false extrema.
+    let w = 5;
+    let sm: Vec<f64> = (0..seg.len())
+        .map(|i| {
+            let a = i.saturating_sub(w);
+            let b = (i + w + 1).min(seg.len());
+            seg[a..b].iter().sum::<f64>() / (b - a) as f64
+        })
+        .collect();
+    let mut ext = Vec::new();
+    let mut last_dir = 0i8;
+    for i in 1..sm.len() {
+        let d = (sm[i] - sm[i - 1]).signum() as i8;
+        if d != 0 {
+            if last_dir != 0 && d != last_dir {
+                ext.push(sm[i - 1]);
+            }
+            last_dir = d;
+        }
+    }
+    // Keep alternating extrema with a real swing (> 4 counts) between them.
+    let min_swing = 4.0 * 2.0 * std::f64::consts::PI / 4096.0;
+    let mut clean: Vec<f64> = Vec::new();
+    for e in ext {
+        if let Some(&last) = clean.last() {
+            if (e - last).abs() < min_swing {
+                continue;
+            }
+        }
+        clean.push(e);
+    }
+    if clean.len() < 3 {
+        return None;
+    }
+    let mut centres: Vec<f64> = clean
+        .windows(3)
+        .map(|w| (w[0] + 2.0 * w[1] + w[2]) / 4.0)
+        .collect();
+    centres.sort_by(f64::total_cmp);
+    Some(centres[centres.len() / 2])
+}

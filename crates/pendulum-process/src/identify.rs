@@ -1,0 +1,503 @@
+//! Preparing runs for the fit, running the study's DE identification and the validation, and the
+//! simulated-vs-measured residual histories.
+
+use std::ops::ControlFlow;
+use std::sync::Arc;
+
+use pendulum_fit::{DeConfig, Driver, FnObserver, GenerationStats, StopRule};
+use pendulum_model::{integrate, Model, SimOptions, SteadyState};
+use serde::{Deserialize, Serialize};
+
+use crate::align::Alignment;
+use crate::fit::{simulated_steady, FitParam, ModelSpec, PreparedRun, StudyObjective};
+use crate::ic::{estimate_state, IcConfig, InitialState};
+use crate::measured::SteadyConfig;
+use crate::run::{Role, RunData};
+use crate::ProcessError;
+
+/// Callback for progress: (stage label, generation statistics).
+pub type ProgressFn = Arc<dyn Fn(&str, &GenerationStats) + Send + Sync>;
+
+/// Fit-window sampling shared by the fit and the validation.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Window {
+    /// Fit window after t = 0, s.
+    pub window_s: f64,
+    /// Samples per second used in E_θ (the encoder is decimated to this).
+    pub sample_hz: f64,
+}
+
+impl Default for Window {
+    fn default() -> Self {
+        Self {
+            window_s: 10.0,
+            sample_hz: 100.0,
+        }
+    }
+}
+
+/// Builds a [`PreparedRun`] from a run and its stage results.
+pub fn prepare_run(
+    run: &RunData,
+    al: &Alignment,
+    ic: &InitialState,
+    steady: &SteadyState,
+    steady_cfg: &SteadyConfig,
+    window: &Window,
+) -> Result<PreparedRun, ProcessError> {
+    let w0 = run.rig.omega0_rad_s();
+    let (t, th) = (&run.enc_t_s, &run.theta_rad);
+    let lo = t.partition_point(|&x| x < al.t0_s);
+    let hi = t.partition_point(|&x| x <= al.t0_s + window.window_s);
+    if hi <= lo + 10 {
+        return Err(ProcessError::Run {
+            run: run.id.clone(),
+            reason: format!(
+                "fewer than 10 encoder samples in the fit window from t0 = {:.3} s",
+                al.t0_s
+            ),
+        });
+    }
+    let rate = (hi - lo - 1) as f64 / (t[hi - 1] - t[lo]).max(1e-9);
+    let step = ((rate / window.sample_hz).round() as usize).max(1);
+    let idx: Vec<usize> = (lo..hi).step_by(step).collect();
+    let period_s = 1.0 / al.omega_hz;
+    let t_end = t[t.len() - 1];
+    let mut tail_t = Vec::new();
+    let mut x = t_end - steady_cfg.tail_s;
+    while x <= t_end - 0.25 * period_s {
+        tail_t.push(w0 * (x - al.t0_s));
+        x += period_s;
+    }
+    Ok(PreparedRun {
+        id: run.id.clone(),
+        role: run.role,
+        rig: run.rig.clone(),
+        omega_hz: al.omega_hz,
+        t: idx.iter().map(|&i| w0 * (t[i] - al.t0_s)).collect(),
+        theta: idx.iter().map(|&i| th[i]).collect(),
+        ic_est: [ic.theta_rad, ic.theta_dot_rad_s / w0],
+        steady: *steady,
+        tail_t,
+        classify: steady_cfg.classify_options(w0 * period_s),
+    })
+}
+
+/// Settings of the identification (the study's defaults; `np = None` means 10·(dimension)).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct FitConfig {
+    /// `reference` (a, b, μ) or `linear` (b).
+    pub model: String,
+    /// Effect parameters fitted on top of the model.
+    pub effects: Vec<FitParam>,
+    #[serde(flatten)]
+    pub window: Window,
+    /// Steady-state penalty factor κ.
+    pub kappa: f64,
+    /// Half-width of the initial-condition boxes (θ rad, dθ/dt dimensionless).
+    pub ic_halfwidth: f64,
+    pub np: Option<usize>,
+    pub f: f64,
+    pub cr: f64,
+    /// Stop when best − worst < tol (absolute, the study's rule) or relative.
+    pub tol: f64,
+    pub stop_rule: StopRule,
+    pub max_generations: u64,
+    pub seed: u64,
+    pub early_abandon: bool,
+    /// Integrator tolerance.
+    pub sim_tol: f64,
+    /// A Nelder–Mead polish after DE, reported apart.
+    pub polish: bool,
+    /// Worker threads (None = all cores).
+    pub threads: Option<usize>,
+}
+
+impl Default for FitConfig {
+    fn default() -> Self {
+        Self {
+            model: "reference".into(),
+            effects: Vec::new(),
+            window: Window::default(),
+            kappa: 2.0,
+            ic_halfwidth: 0.1,
+            np: None,
+            f: 0.8,
+            cr: 0.9,
+            tol: 0.001,
+            stop_rule: StopRule::Absolute,
+            max_generations: 400,
+            seed: 1,
+            early_abandon: true,
+            sim_tol: 1e-8,
+            polish: false,
+            threads: None,
+        }
+    }
+}
+
+impl FitConfig {
+    /// The model spec: the named base plus the configured effect parameters.
+    pub fn spec(&self) -> Result<ModelSpec, ProcessError> {
+        let mut spec = ModelSpec::by_name(&self.model).ok_or_else(|| ProcessError::BadConfig {
+            stage: "fit".into(),
+            field: "model".into(),
+            message: format!(
+                "unknown model {:?}: expected reference or linear",
+                self.model
+            ),
+        })?;
+        for e in &self.effects {
+            if !spec.params.contains(e) {
+                spec.params.push(*e);
+            }
+        }
+        if !self.effects.is_empty() {
+            let names: Vec<&str> = self.effects.iter().map(|e| e.name()).collect();
+            spec.name = format!("{}+{}", spec.name, names.join("+"));
+        }
+        Ok(spec)
+    }
+
+    pub fn validate(&self) -> Result<(), ProcessError> {
+        let bad = |field: &str, message: String| {
+            Err(ProcessError::BadConfig {
+                stage: "fit".into(),
+                field: field.into(),
+                message,
+            })
+        };
+        if !(self.window.window_s > 0.0) {
+            return bad("window_s", format!("{} must be > 0", self.window.window_s));
+        }
+        if !(self.window.sample_hz > 0.0) {
+            return bad(
+                "sample_hz",
+                format!("{} must be > 0", self.window.sample_hz),
+            );
+        }
+        if !(self.kappa >= 1.0) {
+            return bad("kappa", format!("{} must be ≥ 1", self.kappa));
+        }
+        if !(self.ic_halfwidth > 0.0) {
+            return bad("ic_halfwidth", format!("{} must be > 0", self.ic_halfwidth));
+        }
+        if !(self.sim_tol > 0.0 && self.sim_tol < 1e-3) {
+            return bad("sim_tol", format!("{} is not in (0, 1e-3)", self.sim_tol));
+        }
+        self.spec().map(|_| ())
+    }
+}
+
+/// One run's part of a fit.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RunFit {
+    pub id: String,
+    pub role: Role,
+    /// Estimated and fitted initial state (θ rad, dθ/dt dimensionless).
+    pub ic_est: [f64; 2],
+    pub ic_fit: [f64; 2],
+    pub e_theta: f64,
+    pub measured: SteadyState,
+    pub simulated: Option<SteadyState>,
+}
+
+impl RunFit {
+    pub fn steady_agrees(&self) -> bool {
+        self.simulated
+            .is_some_and(|s| s.class == self.measured.class)
+    }
+}
+
+/// A fitted model.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FitOutcome {
+    pub spec: ModelSpec,
+    /// Values of `spec.params`, SI.
+    pub params: Vec<f64>,
+    pub f_obj: f64,
+    pub e_theta: f64,
+    pub generations: u64,
+    pub evaluations: u64,
+    pub abandoned: u64,
+    pub stop_reason: String,
+    pub wall_s: f64,
+    pub seed: u64,
+    pub np: usize,
+    /// (generation, best, worst, mean).
+    pub convergence: Vec<(u64, f64, f64, f64)>,
+    pub runs: Vec<RunFit>,
+    /// Polished parameters and objective, when a polish ran.
+    pub polished: Option<(Vec<f64>, f64, usize)>,
+}
+
+impl FitOutcome {
+    /// Value of a parameter (0 when the model does not have it).
+    pub fn param(&self, p: FitParam) -> f64 {
+        self.spec
+            .params
+            .iter()
+            .zip(&self.params)
+            .find(|(q, _)| **q == p)
+            .map_or(0.0, |(_, v)| *v)
+    }
+}
+
+/// Runs the study's identification on the identify runs.
+pub fn identify(
+    runs: &[PreparedRun],
+    cfg: &FitConfig,
+    progress: Option<ProgressFn>,
+) -> Result<FitOutcome, ProcessError> {
+    cfg.validate()?;
+    let spec = cfg.spec()?;
+    if runs.is_empty() {
+        return Err(ProcessError::BadConfig {
+            stage: "fit".into(),
+            field: "runs".into(),
+            message: "no identify runs".into(),
+        });
+    }
+    let objective = StudyObjective {
+        runs,
+        spec: &spec,
+        kappa: cfg.kappa,
+        sim: SimOptions::with_tol(cfg.sim_tol),
+        ic_halfwidth: cfg.ic_halfwidth,
+        fixed_params: None,
+        penalty: true,
+    };
+    let dim = spec.params.len() + 2 * runs.len();
+    let np = cfg.np.unwrap_or(10 * dim).max(4);
+    let de = DeConfig {
+        np,
+        f: cfg.f,
+        cr: cfg.cr,
+        seed: cfg.seed,
+        max_generations: cfg.max_generations,
+        tol: cfg.tol,
+        stop_rule: cfg.stop_rule,
+        early_abandon: cfg.early_abandon,
+        init: None,
+    };
+    let label = format!("fit {}", spec.name);
+    let mut driver = Driver::new(&objective, de).threads(cfg.threads);
+    if let Some(p) = progress {
+        let label = label.clone();
+        driver = driver.observer(Box::new(FnObserver::new(move |g: &GenerationStats| {
+            p(&label, g)
+        })));
+    }
+    let res = driver.run()?;
+    let polished = if cfg.polish {
+        let step: Vec<f64> = objective
+            .bounds_vec()
+            .iter()
+            .map(|(lo, hi)| 0.05 * (hi - lo))
+            .collect();
+        let (x, f, n) = pendulum_fit::nelder_mead(&objective, &res.best_x, &step, 2000, 1e-6);
+        Some((x, f, n))
+    } else {
+        None
+    };
+    let eval = objective.evaluate(&res.best_x);
+    let n = spec.params.len();
+    let run_fits = runs
+        .iter()
+        .enumerate()
+        .map(|(j, r)| RunFit {
+            id: r.id.clone(),
+            role: r.role,
+            ic_est: r.ic_est,
+            ic_fit: [res.best_x[n + 2 * j], res.best_x[n + 2 * j + 1]],
+            e_theta: eval.per_run_e[j],
+            measured: r.steady,
+            simulated: eval.per_run_sim_steady[j],
+        })
+        .collect();
+    Ok(FitOutcome {
+        params: res.best_x[..n].to_vec(),
+        f_obj: res.best_cost,
+        e_theta: eval.e_theta,
+        generations: res.generations,
+        evaluations: res.evaluations,
+        abandoned: res.abandoned,
+        stop_reason: format!("{:?}", res.stop_reason),
+        wall_s: res.wall_s,
+        seed: cfg.seed,
+        np,
+        convergence: res
+            .history
+            .iter()
+            .map(|g| (g.generation, g.best, g.worst, g.mean))
+            .collect(),
+        runs: run_fits,
+        polished: polished.map(|(x, f, k)| (x[..n].to_vec(), f, k)),
+        spec,
+    })
+}
+
+impl StudyObjective<'_> {
+    fn bounds_vec(&self) -> Vec<(f64, f64)> {
+        pendulum_fit::Problem::bounds(self)
+    }
+}
+
+/// Validation settings: damping fixed, each run's initial state fitted alone (±`ic_halfwidth`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ValidateConfig {
+    #[serde(flatten)]
+    pub window: Window,
+    pub ic_halfwidth: f64,
+    pub np: usize,
+    pub max_generations: u64,
+    pub seed: u64,
+    pub sim_tol: f64,
+}
+
+impl Default for ValidateConfig {
+    fn default() -> Self {
+        Self {
+            window: Window::default(),
+            ic_halfwidth: 0.1,
+            np: 20,
+            max_generations: 60,
+            seed: 1,
+            sim_tol: 1e-8,
+        }
+    }
+}
+
+/// Validates fixed damping parameters on runs: per run, the best initial state and its E_θ.
+pub fn validate(
+    runs: &[PreparedRun],
+    spec: &ModelSpec,
+    params: &[f64],
+    cfg: &ValidateConfig,
+) -> Result<Vec<RunFit>, ProcessError> {
+    use rayon::prelude::*;
+    runs.par_iter()
+        .map(|run| {
+            let single = std::slice::from_ref(run);
+            let objective = StudyObjective {
+                runs: single,
+                spec,
+                kappa: 1.0,
+                sim: SimOptions::with_tol(cfg.sim_tol),
+                ic_halfwidth: cfg.ic_halfwidth,
+                fixed_params: Some(params.to_vec()),
+                penalty: false,
+            };
+            let de = DeConfig {
+                np: cfg.np,
+                seed: cfg.seed,
+                max_generations: cfg.max_generations,
+                tol: 1e-6,
+                stop_rule: StopRule::Relative,
+                ..DeConfig::default()
+            };
+            let res = Driver::new(&objective, de).threads(Some(1)).run()?;
+            let eval = objective.evaluate(&res.best_x);
+            Ok(RunFit {
+                id: run.id.clone(),
+                role: run.role,
+                ic_est: run.ic_est,
+                ic_fit: [res.best_x[0], res.best_x[1]],
+                e_theta: eval.per_run_e[0],
+                measured: run.steady,
+                simulated: eval.per_run_sim_steady[0],
+            })
+        })
+        .collect()
+}
+
+/// Simulated vs measured over a run's forced part, at the fit's sampling.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ResidualSeries {
+    /// Dimensionless time from t = 0.
+    pub t: Vec<f64>,
+    /// Seconds from t = 0.
+    pub tau_s: Vec<f64>,
+    pub theta_meas: Vec<f64>,
+    pub theta_sim: Vec<f64>,
+    /// rad/s.
+    pub theta_dot_meas: Vec<f64>,
+    pub theta_dot_sim: Vec<f64>,
+}
+
+/// Simulates the fitted model from its fitted initial state over [0, t_end_s] after t0 and pairs
+/// it with the measurement (θ̇ measured by a local cubic fit, ±`ic.half_window_s`).
+pub fn residual_series(
+    run: &RunData,
+    al: &Alignment,
+    spec: &ModelSpec,
+    params: &[f64],
+    ic_fit: [f64; 2],
+    window: &Window,
+    t_end_s: f64,
+) -> Result<ResidualSeries, ProcessError> {
+    let w0 = run.rig.omega0_rad_s();
+    let model = Model::new(
+        spec.physical(&run.rig, al.omega_hz, params)
+            .to_dimensionless(),
+    );
+    let (t, th) = (&run.enc_t_s, &run.theta_rad);
+    let lo = t.partition_point(|&x| x < al.t0_s);
+    let hi = t.partition_point(|&x| x <= al.t0_s + t_end_s);
+    if hi <= lo + 2 {
+        return Ok(ResidualSeries::default());
+    }
+    let rate = (hi - lo - 1) as f64 / (t[hi - 1] - t[lo]).max(1e-9);
+    let step = ((rate / window.sample_hz).round() as usize).max(1);
+    let idx: Vec<usize> = (lo..hi).step_by(step).collect();
+    let times: Vec<f64> = idx.iter().map(|&i| w0 * (t[i] - al.t0_s)).collect();
+    let offset = spec
+        .params
+        .iter()
+        .zip(params)
+        .find(|(p, _)| **p == FitParam::EncoderOffset)
+        .map_or(0.0, |(_, v)| *v);
+    let mut out = ResidualSeries::default();
+    let t_last = *times.last().unwrap_or(&0.0);
+    integrate(
+        &model,
+        &SimOptions::with_tol(1e-9),
+        0.0,
+        ic_fit,
+        t_last,
+        times.iter().copied(),
+        |s| {
+            out.theta_sim.push(s.theta + offset);
+            out.theta_dot_sim.push(s.theta_dot * w0);
+            ControlFlow::Continue(())
+        },
+    )?;
+    let ic_cfg = IcConfig::default();
+    for (k, &i) in idx.iter().enumerate().take(out.theta_sim.len()) {
+        out.t.push(times[k]);
+        out.tau_s.push(t[i] - al.t0_s);
+        out.theta_meas.push(th[i]);
+        let w = estimate_state(run, t[i], &ic_cfg)
+            .map(|s| s.theta_dot_rad_s)
+            .unwrap_or(f64::NAN);
+        out.theta_dot_meas.push(w);
+    }
+    Ok(out)
+}
+
+/// The simulated steady state of a prepared run from an initial state (for reports).
+pub fn steady_from(
+    run: &PreparedRun,
+    spec: &ModelSpec,
+    params: &[f64],
+    y0: [f64; 2],
+) -> Option<SteadyState> {
+    let model = Model::new(
+        spec.physical(&run.rig, run.omega_hz, params)
+            .to_dimensionless(),
+    );
+    simulated_steady(&model, &SimOptions::with_tol(1e-8), run, 0.0, y0)
+}

@@ -1,0 +1,475 @@
+//! `campaign.toml`: which captures make up a campaign, and each run's rig geometry.
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+use toml::Value;
+
+use crate::error::RigError;
+
+/// The file name of a campaign description inside its folder.
+pub const CAMPAIGN_FILE: &str = "campaign.toml";
+
+/// What a run is used for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Role {
+    /// The run takes part in fitting the damping parameters.
+    Identify,
+    /// The run only checks the fitted parameters.
+    Validate,
+}
+
+impl Role {
+    pub fn as_str(&self) -> &'static str {
+        match self {
+            Role::Identify => "identify",
+            Role::Validate => "validate",
+        }
+    }
+}
+
+/// One run, with the rig-table defaults already applied.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct RunSpec {
+    pub id: String,
+    /// The capture, resolved against the campaign folder.
+    pub file: PathBuf,
+    pub role: Role,
+    pub m_kg: f64,
+    pub l_m: f64,
+    pub crank_r_m: f64,
+    /// Key `rod_L_m`.
+    pub rod_l_m: f64,
+    pub r_b_m: f64,
+    /// Crank speed set point (the accelerometer says what it really was).
+    pub omega_hz: Option<f64>,
+    /// `"serial-v1"` or `"sd-v2"`, if the experimenter said; readers detect it anyway.
+    pub format: Option<String>,
+    /// Every key not listed above, from the rig table and the run (the run wins).
+    pub extra: BTreeMap<String, Value>,
+}
+
+/// A campaign folder's description.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Campaign {
+    /// The folder holding `campaign.toml` and the captures.
+    pub dir: PathBuf,
+    /// `name`, or the folder's name when absent.
+    pub name: String,
+    /// `g_m_s2`, default 9.81.
+    pub g_m_s2: f64,
+    /// The `[rig]` table as written (defaults for every run).
+    pub rig: BTreeMap<String, Value>,
+    pub runs: Vec<RunSpec>,
+    /// Unknown top-level keys.
+    pub extra: BTreeMap<String, Value>,
+}
+
+const RUN_KEYS: [&str; 10] = [
+    "id",
+    "file",
+    "role",
+    "m_kg",
+    "l_m",
+    "crank_r_m",
+    "rod_L_m",
+    "r_b_m",
+    "omega_hz",
+    "format",
+];
+const FORMATS: [&str; 2] = ["serial-v1", "sd-v2"];
+
+impl Campaign {
+    /// Loads `dir/campaign.toml`, or the given `.toml` file (its folder is the campaign's).
+    pub fn load(dir_or_toml: impl AsRef<Path>) -> Result<Self, RigError> {
+        let p = dir_or_toml.as_ref();
+        let toml_path = if p.is_dir() {
+            p.join(CAMPAIGN_FILE)
+        } else {
+            p.to_path_buf()
+        };
+        let text = std::fs::read_to_string(&toml_path).map_err(|e| RigError::io(&toml_path, e))?;
+        Self::parse(&text, &toml_path)
+    }
+
+    /// Parses campaign text; `toml_path` names the file in messages and its folder resolves
+    /// the run files.
+    pub fn parse(text: &str, toml_path: impl AsRef<Path>) -> Result<Self, RigError> {
+        let path = toml_path.as_ref();
+        let dir = match path.parent() {
+            Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+            _ => PathBuf::from("."),
+        };
+        let mut table: toml::Table = toml::from_str(text).map_err(|e| {
+            let (line, column) = e.span().map(|s| line_col(text, s.start)).unwrap_or((1, 1));
+            RigError::CampaignSyntax {
+                path: path.to_path_buf(),
+                line,
+                column,
+                message: e.message().trim().to_string(),
+            }
+        })?;
+        let key_err = |run: Option<String>, key: &str, expected: &str| RigError::CampaignKey {
+            path: path.to_path_buf(),
+            run,
+            key: key.to_string(),
+            expected: expected.to_string(),
+        };
+
+        let name = match table.remove("name") {
+            None => dir
+                .canonicalize()
+                .ok()
+                .and_then(|d| d.file_name().map(|n| n.to_string_lossy().into_owned()))
+                .unwrap_or_else(|| "campaign".to_string()),
+            Some(Value::String(s)) => s,
+            Some(_) => return Err(key_err(None, "name", "a string")),
+        };
+        let g_m_s2 = match table.remove("g_m_s2") {
+            None => 9.81,
+            Some(v) => positive(&v).ok_or_else(|| key_err(None, "g_m_s2", "a positive number"))?,
+        };
+        let rig: BTreeMap<String, Value> = match table.remove("rig") {
+            None => BTreeMap::new(),
+            Some(Value::Table(t)) => t.into_iter().collect(),
+            Some(_) => return Err(key_err(None, "rig", "a table [rig]")),
+        };
+        let run_values = match table.remove("run") {
+            None => Vec::new(),
+            Some(Value::Array(a)) => a,
+            Some(_) => return Err(key_err(None, "run", "an array of tables [[run]]")),
+        };
+        let extra: BTreeMap<String, Value> = table.into_iter().collect();
+
+        let mut runs = Vec::with_capacity(run_values.len());
+        let mut ids = BTreeSet::new();
+        for (i, v) in run_values.into_iter().enumerate() {
+            let Value::Table(t) = v else {
+                return Err(key_err(
+                    Some(format!("run #{}", i + 1)),
+                    "run",
+                    "a table [[run]]",
+                ));
+            };
+            let run = Self::parse_run(path, &dir, &rig, t, i)?;
+            if !ids.insert(run.id.clone()) {
+                return Err(RigError::DuplicateRunId {
+                    path: path.to_path_buf(),
+                    run_id: run.id,
+                });
+            }
+            runs.push(run);
+        }
+        Ok(Campaign {
+            dir,
+            name,
+            g_m_s2,
+            rig,
+            runs,
+            extra,
+        })
+    }
+
+    fn parse_run(
+        path: &Path,
+        dir: &Path,
+        rig: &BTreeMap<String, Value>,
+        run: toml::Table,
+        index: usize,
+    ) -> Result<RunSpec, RigError> {
+        let mut merged: BTreeMap<String, Value> = rig.clone();
+        merged.extend(run);
+        let mut label = format!("run #{}", index + 1);
+        let key_err = |label: &str, key: &str, expected: &str| RigError::CampaignKey {
+            path: path.to_path_buf(),
+            run: Some(label.to_string()),
+            key: key.to_string(),
+            expected: expected.to_string(),
+        };
+        let id = match merged.get("id") {
+            Some(Value::String(s)) if !s.is_empty() => s.clone(),
+            _ => return Err(key_err(&label, "id", "a non-empty string")),
+        };
+        label = id.clone();
+        let file = match merged.get("file") {
+            Some(Value::String(s)) if !s.is_empty() => dir.join(s),
+            _ => {
+                return Err(key_err(
+                    &label,
+                    "file",
+                    "a non-empty string (capture file name)",
+                ))
+            }
+        };
+        let role = match merged.get("role") {
+            Some(Value::String(s)) => match s.as_str() {
+                "identify" => Role::Identify,
+                "validate" => Role::Validate,
+                _ => {
+                    return Err(RigError::BadRole {
+                        path: path.to_path_buf(),
+                        run: label,
+                        value: s.clone(),
+                    })
+                }
+            },
+            _ => return Err(key_err(&label, "role", "\"identify\" or \"validate\"")),
+        };
+        let num = |key: &str| -> Result<f64, RigError> {
+            merged
+                .get(key)
+                .and_then(positive)
+                .ok_or_else(|| key_err(&label, key, "a positive number"))
+        };
+        let m_kg = num("m_kg")?;
+        let l_m = num("l_m")?;
+        let crank_r_m = num("crank_r_m")?;
+        let rod_l_m = num("rod_L_m")?;
+        let r_b_m = num("r_b_m")?;
+        let omega_hz = match merged.get("omega_hz") {
+            None => None,
+            Some(_) => Some(num("omega_hz")?),
+        };
+        let format = match merged.get("format") {
+            None => None,
+            Some(Value::String(s)) if FORMATS.contains(&s.as_str()) => Some(s.clone()),
+            Some(_) => return Err(key_err(&label, "format", "\"serial-v1\" or \"sd-v2\"")),
+        };
+        let extra = merged
+            .into_iter()
+            .filter(|(k, _)| !RUN_KEYS.contains(&k.as_str()))
+            .collect();
+        Ok(RunSpec {
+            id,
+            file,
+            role,
+            m_kg,
+            l_m,
+            crank_r_m,
+            rod_l_m,
+            r_b_m,
+            omega_hz,
+            format,
+            extra,
+        })
+    }
+
+    /// The path of `campaign.toml`.
+    pub fn toml_path(&self) -> PathBuf {
+        self.dir.join(CAMPAIGN_FILE)
+    }
+
+    /// Fails with [`RigError::MissingRunFile`] for the first run whose capture is absent.
+    pub fn check_files(&self) -> Result<(), RigError> {
+        match self.runs.iter().find(|r| !r.file.is_file()) {
+            Some(r) => Err(RigError::MissingRunFile {
+                path: r.file.clone(),
+                run_id: r.id.clone(),
+            }),
+            None => Ok(()),
+        }
+    }
+
+    /// The runs with this role.
+    pub fn runs_with_role(&self, role: Role) -> impl Iterator<Item = &RunSpec> {
+        self.runs.iter().filter(move |r| r.role == role)
+    }
+
+    /// TOML text that [`Campaign::load`] reads back into an equal campaign (when it sits in
+    /// the same folder). Run files inside the folder are written relative to it; every run
+    /// key is written explicitly, so the `[rig]` table is kept only as metadata-and-defaults.
+    pub fn to_toml_string(&self) -> Result<String, RigError> {
+        let mut top = toml::Table::new();
+        top.insert("name".into(), Value::String(self.name.clone()));
+        top.insert("g_m_s2".into(), Value::Float(self.g_m_s2));
+        for (k, v) in &self.extra {
+            top.insert(k.clone(), v.clone());
+        }
+        if !self.rig.is_empty() {
+            top.insert(
+                "rig".into(),
+                Value::Table(self.rig.clone().into_iter().collect()),
+            );
+        }
+        let runs = self
+            .runs
+            .iter()
+            .map(|r| Value::Table(self.run_table(r)))
+            .collect();
+        top.insert("run".into(), Value::Array(runs));
+        toml::to_string(&top).map_err(|e| RigError::CampaignWrite {
+            path: self.toml_path(),
+            message: e.to_string(),
+        })
+    }
+
+    fn run_table(&self, r: &RunSpec) -> toml::Table {
+        let mut t = toml::Table::new();
+        for (k, v) in &r.extra {
+            t.insert(k.clone(), v.clone());
+        }
+        let file = r.file.strip_prefix(&self.dir).unwrap_or(&r.file);
+        t.insert("id".into(), Value::String(r.id.clone()));
+        t.insert(
+            "file".into(),
+            Value::String(file.to_string_lossy().into_owned()),
+        );
+        t.insert("role".into(), Value::String(r.role.as_str().into()));
+        t.insert("m_kg".into(), Value::Float(r.m_kg));
+        t.insert("l_m".into(), Value::Float(r.l_m));
+        t.insert("crank_r_m".into(), Value::Float(r.crank_r_m));
+        t.insert("rod_L_m".into(), Value::Float(r.rod_l_m));
+        t.insert("r_b_m".into(), Value::Float(r.r_b_m));
+        if let Some(w) = r.omega_hz {
+            t.insert("omega_hz".into(), Value::Float(w));
+        }
+        if let Some(f) = &r.format {
+            t.insert("format".into(), Value::String(f.clone()));
+        }
+        t
+    }
+
+    /// Writes [`Campaign::to_toml_string`] to `path`: a folder (then `campaign.toml` in it) or
+    /// a file path.
+    pub fn write(&self, path: impl AsRef<Path>) -> Result<(), RigError> {
+        let p = path.as_ref();
+        let target = if p.is_dir() {
+            p.join(CAMPAIGN_FILE)
+        } else {
+            p.to_path_buf()
+        };
+        let text = self.to_toml_string()?;
+        std::fs::write(&target, text).map_err(|e| RigError::io(&target, e))
+    }
+}
+
+/// A positive finite number; TOML integers are accepted (`m_kg = 1`).
+fn positive(v: &Value) -> Option<f64> {
+    let x = match v {
+        Value::Float(f) => *f,
+        Value::Integer(i) => *i as f64,
+        _ => return None,
+    };
+    (x.is_finite() && x > 0.0).then_some(x)
+}
+
+/// 1-based line and column (in characters) of a byte offset.
+fn line_col(text: &str, offset: usize) -> (usize, usize) {
+    let mut off = offset.min(text.len());
+    while !text.is_char_boundary(off) {
+        off -= 1;
+    }
+    let before = &text[..off];
+    let line = before.matches('\n').count() + 1;
+    let col = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+    (line, col)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const EXAMPLE: &str = r#"
+name = "damping-2026-03"
+g_m_s2 = 9.81
+operator = "ann"
+
+[rig]                 # shared by every run unless a run overrides a key
+r_b_m = 0.01225
+rod_L_m = 0.575
+bearing = "P203"
+
+[[run]]
+id = "r01"
+file = "r01.csv"
+m_kg = 1.46
+l_m = 0.265
+crank_r_m = 0.0725
+omega_hz = 1.54
+role = "identify"
+note = "fresh grease"
+
+[[run]]
+id = "r02"
+file = "sub/r02.bin"
+m_kg = 1
+l_m = 0.17
+crank_r_m = 0.205
+r_b_m = 0.02
+role = "validate"
+format = "sd-v2"
+"#;
+
+    #[test]
+    fn parses_defaults_overrides_and_unknown_keys() {
+        let c = Campaign::parse(EXAMPLE, "/data/c1/campaign.toml").unwrap();
+        assert_eq!(c.name, "damping-2026-03");
+        assert_eq!(c.dir, PathBuf::from("/data/c1"));
+        assert_eq!(c.extra["operator"].as_str(), Some("ann"));
+        let r1 = &c.runs[0];
+        assert_eq!(r1.file, PathBuf::from("/data/c1/r01.csv"));
+        assert_eq!(r1.r_b_m, 0.01225);
+        assert_eq!(r1.rod_l_m, 0.575);
+        assert_eq!(r1.omega_hz, Some(1.54));
+        assert_eq!(r1.role, Role::Identify);
+        assert_eq!(r1.extra["note"].as_str(), Some("fresh grease"));
+        assert_eq!(r1.extra["bearing"].as_str(), Some("P203"));
+        let r2 = &c.runs[1];
+        assert_eq!(r2.r_b_m, 0.02);
+        assert_eq!(r2.m_kg, 1.0);
+        assert_eq!(r2.omega_hz, None);
+        assert_eq!(r2.format.as_deref(), Some("sd-v2"));
+        assert_eq!(r2.role, Role::Validate);
+    }
+
+    #[test]
+    fn errors_name_file_run_and_key() {
+        let text = EXAMPLE.replace("l_m = 0.265\n", "");
+        let e = Campaign::parse(&text, "c/campaign.toml").unwrap_err();
+        let msg = e.to_string();
+        assert!(matches!(e, RigError::CampaignKey { .. }));
+        assert!(
+            msg.contains("c/campaign.toml") && msg.contains("r01") && msg.contains("l_m"),
+            "{msg}"
+        );
+
+        let text = EXAMPLE.replace("m_kg = 1.46", "m_kg = \"heavy\"");
+        let msg = Campaign::parse(&text, "c/campaign.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            msg.contains("r01") && msg.contains("m_kg") && msg.contains("number"),
+            "{msg}"
+        );
+
+        let text = EXAMPLE.replace("id = \"r02\"\n", "");
+        let msg = Campaign::parse(&text, "c/campaign.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(msg.contains("run #2") && msg.contains("`id`"), "{msg}");
+
+        let text = EXAMPLE.replace("role = \"validate\"", "role = \"check\"");
+        let e = Campaign::parse(&text, "c/campaign.toml").unwrap_err();
+        assert!(matches!(e, RigError::BadRole { .. }), "{e}");
+
+        let text = EXAMPLE.replace("id = \"r02\"", "id = \"r01\"");
+        let e = Campaign::parse(&text, "c/campaign.toml").unwrap_err();
+        assert!(matches!(e, RigError::DuplicateRunId { .. }), "{e}");
+
+        let text = EXAMPLE.replace("m_kg = 1.46", "m_kg = = 1.46");
+        match Campaign::parse(&text, "c/campaign.toml").unwrap_err() {
+            RigError::CampaignSyntax { line, .. } => assert_eq!(line, 14),
+            e => panic!("{e}"),
+        }
+    }
+
+    #[test]
+    fn round_trips_through_text() {
+        let c = Campaign::parse(EXAMPLE, "/data/c1/campaign.toml").unwrap();
+        let text = c.to_toml_string().unwrap();
+        let back = Campaign::parse(&text, "/data/c1/campaign.toml").unwrap();
+        assert_eq!(back, c, "{text}");
+    }
+}

@@ -1,0 +1,627 @@
+//! Types shared by both capture formats, and the bookkeeping both readers do the same way
+//! (clock and encoder unwrapping, gap detection, outlier rejection, statistics).
+
+use std::f64::consts::TAU;
+use std::fmt;
+use std::path::Path;
+
+use serde::Serialize;
+
+use crate::error::RigError;
+
+/// Encoder counts per revolution when the header does not say (1024 lines, quadrature ×4).
+pub const DEFAULT_ENCODER_CPR: u32 = 4096;
+/// Accelerometer sensitivity when the header does not say (±4 g range).
+pub const DEFAULT_ACCEL_LSB_PER_G: f64 = 8192.0;
+/// Serial line rate when the header does not say.
+pub const DEFAULT_SAMPLE_HZ: f64 = 200.0;
+/// SD encoder frame rate when the header does not say.
+pub const DEFAULT_ENCODER_HZ: f64 = 1000.0;
+/// SD accelerometer frame rate when the header does not say.
+pub const DEFAULT_ACCEL_HZ: f64 = 200.0;
+/// How many [`Skip`]s are kept in full in [`IngestStats::skips`].
+pub const MAX_SKIPS_KEPT: usize = 20;
+/// How many [`Gap`]s are kept in full in [`IngestStats::gaps`].
+pub const MAX_GAPS_KEPT: usize = 100;
+
+/// The `key=value` header of a capture, every key in file order (unknown keys too: they are
+/// metadata the experimenter may need later).
+#[derive(Debug, Clone, Default, PartialEq, Eq, Serialize)]
+pub struct Header {
+    pub entries: Vec<(String, String)>,
+}
+
+impl Header {
+    /// An empty header (every accessor then returns its default).
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// The header the `serial-v1` firmware writes (without `started`).
+    pub fn serial_v1() -> Self {
+        Self::new()
+            .with("firmware", "serial-v1")
+            .with("encoder_cpr", "4096")
+            .with("accel_lsb_per_g", "8192")
+            .with("sample_hz", "200")
+    }
+
+    /// The header the `sd-v2` firmware writes (without `started`).
+    pub fn sd_v2() -> Self {
+        Self::new()
+            .with("firmware", "sd-v2")
+            .with("encoder_cpr", "4096")
+            .with("accel_lsb_per_g", "8192")
+            .with("encoder_hz", "1000")
+            .with("accel_hz", "200")
+    }
+
+    /// Builder form of [`Header::set`].
+    pub fn with(mut self, key: impl Into<String>, value: impl Into<String>) -> Self {
+        self.set(key, value);
+        self
+    }
+
+    /// Replaces the first entry with this key, or appends one.
+    pub fn set(&mut self, key: impl Into<String>, value: impl Into<String>) {
+        let key = key.into();
+        let value = value.into();
+        match self.entries.iter_mut().find(|(k, _)| *k == key) {
+            Some(e) => e.1 = value,
+            None => self.entries.push((key, value)),
+        }
+    }
+
+    /// The value of the first entry with this key.
+    pub fn get(&self, key: &str) -> Option<&str> {
+        self.entries
+            .iter()
+            .find(|(k, _)| k == key)
+            .map(|(_, v)| v.as_str())
+    }
+
+    pub fn firmware(&self) -> Option<&str> {
+        self.get("firmware")
+    }
+
+    /// When logging started, as written by the firmware (ISO 8601), if known.
+    pub fn started(&self) -> Option<&str> {
+        self.get("started")
+    }
+
+    /// Encoder counts per revolution (default 4096).
+    pub fn encoder_cpr(&self) -> u32 {
+        self.positive::<u32>("encoder_cpr")
+            .unwrap_or(DEFAULT_ENCODER_CPR)
+    }
+
+    /// Accelerometer LSB per g (default 8192).
+    pub fn accel_lsb_per_g(&self) -> f64 {
+        self.positive_f64("accel_lsb_per_g")
+            .unwrap_or(DEFAULT_ACCEL_LSB_PER_G)
+    }
+
+    /// Serial line rate in Hz (default 200).
+    pub fn sample_hz(&self) -> f64 {
+        self.positive_f64("sample_hz").unwrap_or(DEFAULT_SAMPLE_HZ)
+    }
+
+    /// SD encoder frame rate in Hz (default 1000).
+    pub fn encoder_hz(&self) -> f64 {
+        self.positive_f64("encoder_hz")
+            .unwrap_or(DEFAULT_ENCODER_HZ)
+    }
+
+    /// SD accelerometer frame rate in Hz (default 200).
+    pub fn accel_hz(&self) -> f64 {
+        self.positive_f64("accel_hz").unwrap_or(DEFAULT_ACCEL_HZ)
+    }
+
+    fn positive<T: std::str::FromStr + PartialOrd + Default>(&self, key: &str) -> Option<T> {
+        self.get(key)
+            .and_then(|v| v.trim().parse::<T>().ok())
+            .filter(|v| *v > T::default())
+    }
+
+    fn positive_f64(&self, key: &str) -> Option<f64> {
+        self.positive::<f64>(key).filter(|v| v.is_finite())
+    }
+
+    /// Rejects a present-but-unusable numeric key: silently falling back to the default would
+    /// turn a typo into wrong angles or accelerations.
+    pub(crate) fn validate(&self, path: &Path) -> Result<(), RigError> {
+        let bad = |key: &str, expected: &str| RigError::BadHeader {
+            path: path.to_path_buf(),
+            key: key.to_string(),
+            value: self.get(key).unwrap_or_default().to_string(),
+            expected: expected.to_string(),
+        };
+        if self.get("encoder_cpr").is_some() && self.positive::<u32>("encoder_cpr").is_none() {
+            return Err(bad(
+                "encoder_cpr",
+                "a positive integer (counts per revolution)",
+            ));
+        }
+        for key in ["accel_lsb_per_g", "sample_hz", "encoder_hz", "accel_hz"] {
+            if self.get(key).is_some() && self.positive_f64(key).is_none() {
+                return Err(bad(key, "a positive number"));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// One encoder reading.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct EncoderSample {
+    /// The board's 32-bit microsecond clock as logged.
+    pub t_us_raw: u32,
+    /// The board clock unwrapped: `t_us_raw + 2^32 · wraps` since the capture's first sample.
+    pub t_us: u64,
+    /// The 16-bit count as logged.
+    pub count_raw: i16,
+    /// The count unwrapped (continuous across the ±32768 wrap), zero at power-on.
+    pub count: i64,
+    /// Angle from the hanging position, `(count + 0.5) · 2π / cpr`. The firmware's count is
+    /// `floor(cpr · θ / 2π)`, so the true angle lies anywhere in `[count, count + 1)` counts: the
+    /// bin centre is the unbiased estimate (using `count` itself would bias θ by half a count).
+    pub theta_rad: f64,
+}
+
+/// One accelerometer reading.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct AccelSample {
+    pub t_us_raw: u32,
+    /// Unwrapped board clock, as in [`EncoderSample::t_us`].
+    pub t_us: u64,
+    /// Raw `[x, y, z]` as logged.
+    pub raw: [i16; 3],
+    /// `raw / lsb_per_g · g`: specific force, so z reads about +g at rest.
+    pub si_m_s2: [f64; 3],
+}
+
+/// One sample of either sensor, in file order.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub enum Sample {
+    Encoder(EncoderSample),
+    Accel(AccelSample),
+}
+
+impl Sample {
+    /// Unwrapped board time.
+    pub fn t_us(&self) -> u64 {
+        match self {
+            Sample::Encoder(e) => e.t_us,
+            Sample::Accel(a) => a.t_us,
+        }
+    }
+
+    /// Board time as logged.
+    pub fn t_us_raw(&self) -> u32 {
+        match self {
+            Sample::Encoder(e) => e.t_us_raw,
+            Sample::Accel(a) => a.t_us_raw,
+        }
+    }
+}
+
+/// Where in a capture something happened.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Location {
+    /// 1-based line number (serial captures).
+    Line(u64),
+    /// 0-based byte offset (SD captures).
+    Byte(u64),
+}
+
+impl fmt::Display for Location {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Location::Line(n) => write!(f, "line {n}"),
+            Location::Byte(n) => write!(f, "byte {n}"),
+        }
+    }
+}
+
+/// A damaged line or frame region that was dropped.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+pub struct Skip {
+    pub at: Location,
+    pub reason: String,
+}
+
+/// A time step longer than `gap_factor ×` the nominal sample period.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+pub struct Gap {
+    /// Which stream: `"serial"`, `"encoder"` or `"accel"`.
+    pub stream: &'static str,
+    /// Unwrapped time of the last sample before the gap.
+    pub after_t_us: u64,
+    /// Unwrapped time of the first sample after the gap.
+    pub before_t_us: u64,
+    /// `round(step / period) − 1`.
+    pub missing_samples_est: u64,
+}
+
+/// What a reader kept, dropped and noticed.
+#[derive(Debug, Clone, Default, PartialEq, Eq, Serialize)]
+pub struct IngestStats {
+    pub encoder_samples: u64,
+    pub accel_samples: u64,
+    /// Serial: damaged lines. SD: damaged regions (one region may span several frames) and
+    /// frames rejected for their content.
+    pub skipped_lines_or_frames: u64,
+    /// Serial: bytes of the skipped lines. SD: bytes dropped while resynchronising plus frames
+    /// rejected for their content (with the kept frames, the header frame and the truncated
+    /// tail, this accounts for every byte of the file).
+    pub skipped_bytes: u64,
+    /// The first [`MAX_SKIPS_KEPT`] skips, in file order.
+    pub skips: Vec<Skip>,
+    /// The first [`MAX_GAPS_KEPT`] gaps.
+    pub gaps: Vec<Gap>,
+    /// Every gap, including those not kept in `gaps`.
+    pub gap_count: u64,
+    pub clock_wraps: u64,
+    pub encoder_wraps: u64,
+    /// Bytes of a frame cut by the end of the file (power cut).
+    pub truncated_tail_bytes: u64,
+}
+
+impl IngestStats {
+    /// One line for logs and reports.
+    pub fn summary(&self) -> String {
+        format!(
+            "{} encoder + {} accel samples; {} lines/frames skipped ({} bytes); {} gaps; \
+             {} clock wraps; {} encoder wraps; {} truncated tail bytes",
+            self.encoder_samples,
+            self.accel_samples,
+            self.skipped_lines_or_frames,
+            self.skipped_bytes,
+            self.gap_count,
+            self.clock_wraps,
+            self.encoder_wraps,
+            self.truncated_tail_bytes
+        )
+    }
+
+    /// Records a skip, keeping the kept list in file order (a reader may decide on a line only
+    /// after having looked at the next one).
+    pub(crate) fn skip(&mut self, at: Location, reason: impl Into<String>, bytes: u64) {
+        self.skipped_lines_or_frames += 1;
+        self.skipped_bytes += bytes;
+        if self.skips.len() < MAX_SKIPS_KEPT {
+            let key = loc_key(at);
+            let idx = self.skips.partition_point(|s| loc_key(s.at) <= key);
+            self.skips.insert(
+                idx,
+                Skip {
+                    at,
+                    reason: reason.into(),
+                },
+            );
+        }
+    }
+
+    fn gap(&mut self, gap: Gap) {
+        self.gap_count += 1;
+        if self.gaps.len() < MAX_GAPS_KEPT {
+            self.gaps.push(gap);
+        }
+    }
+}
+
+fn loc_key(l: Location) -> u64 {
+    match l {
+        Location::Line(n) | Location::Byte(n) => n,
+    }
+}
+
+/// Reading options.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct ReadOptions {
+    /// Local gravity used to convert accelerometer LSB to m/s².
+    pub g_m_s2: f64,
+    /// A time step longer than `gap_factor ×` the nominal period is reported as a gap.
+    pub gap_factor: f64,
+}
+
+impl Default for ReadOptions {
+    fn default() -> Self {
+        Self {
+            g_m_s2: 9.81,
+            gap_factor: 3.0,
+        }
+    }
+}
+
+/// Angle of an (unwrapped) count, at the centre of its quantisation bin.
+pub(crate) fn theta_rad(count: i64, cpr: u32) -> f64 {
+    (count as f64 + 0.5) * TAU / f64::from(cpr.max(1))
+}
+
+pub(crate) fn accel_si(raw: [i16; 3], lsb_per_g: f64, g_m_s2: f64) -> [f64; 3] {
+    raw.map(|r| f64::from(r) / lsb_per_g * g_m_s2)
+}
+
+/// Step from `from` to `to` on the wrapping 32-bit clock: positive forward (also across a wrap),
+/// negative backwards; a raw value smaller than the previous by more than 2^31 is a wrap.
+pub(crate) fn signed_step(from: u32, to: u32) -> i64 {
+    i64::from(to.wrapping_sub(from) as i32)
+}
+
+/// How [`check_order`] judges time steps, in µs.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct OrderRule {
+    /// A step of at least this is "in order" (1 for one stream; negative when two streams with
+    /// skewed stamps are interleaved).
+    pub min_step_us: i64,
+    /// The nominal step, used to decide which of two contradicting records to believe.
+    pub period_us: i64,
+    /// The largest step that needs no confirmation by the following records (at the end of
+    /// the file nothing can confirm it).
+    pub max_lone_step_us: i64,
+}
+
+/// How many following records must continue smoothly from a record that jumps ahead (or
+/// starts the capture) before it is believed. Nearby lines share their leading digits, so two
+/// or three neighbouring merged lines can agree with each other; a real gap is followed by a
+/// steady stream.
+pub(crate) const CONFIRM_RECORDS: usize = 3;
+
+/// Outlier rejection with a few records of lookahead, on the raw clock.
+///
+/// A damaged record that still parses (merged serial lines, a CRC collision) nearly always has a
+/// time that does not fit between its neighbours. `prev` is the last kept record, `next` the
+/// following candidates (up to [`CONFIRM_RECORDS`], fewer at the end of the file).
+/// - A step longer than `max_lone_step_us` (a jump ahead, or the first record) is believed only
+///   if the next records follow it with ordinary steps.
+/// - When the candidate and the next record contradict each other but both follow `prev`, the
+///   one whose step from `prev` is closer to the nominal period is believed.
+///
+/// Keeping a damaged record would invent a sample and make every later one look out of order,
+/// so when unsure the candidate is the one dropped.
+pub(crate) fn check_order(
+    prev: Option<u32>,
+    cand: u32,
+    next: &[u32],
+    rule: OrderRule,
+) -> Result<(), &'static str> {
+    let ok = |a: u32, b: u32| signed_step(a, b) >= rule.min_step_us;
+    let ordinary = |a: u32, b: u32| ok(a, b) && signed_step(a, b) <= rule.max_lone_step_us;
+    let confirmed = || {
+        let mut last = cand;
+        for &n in next {
+            if !ordinary(last, n) {
+                return false;
+            }
+            last = n;
+        }
+        true
+    };
+    let Some(p) = prev else {
+        // A capture of one record has nothing to check it against: kept.
+        return if confirmed() {
+            Ok(())
+        } else {
+            Err("first record not followed by a steady stream")
+        };
+    };
+    if !ok(p, cand) {
+        return Err("time goes backwards");
+    }
+    if signed_step(p, cand) > rule.max_lone_step_us {
+        return if !next.is_empty() && confirmed() {
+            Ok(())
+        } else {
+            Err("time jumps ahead and the next records do not follow")
+        };
+    }
+    let Some(&n) = next.first() else {
+        return Ok(());
+    };
+    if ok(cand, n) || !ok(p, n) {
+        return Ok(());
+    }
+    let off = |x: u32| (signed_step(p, x) - rule.period_us).abs();
+    if off(cand) <= off(n) {
+        Ok(())
+    } else {
+        Err("time jumps out of order with its neighbours")
+    }
+}
+
+/// Unwraps the shared 32-bit board clock.
+#[derive(Debug, Default)]
+pub(crate) struct Clock {
+    last_raw: Option<u32>,
+    last_t: i64,
+    max_t: i64,
+}
+
+impl Clock {
+    pub(crate) fn last_raw(&self) -> Option<u32> {
+        self.last_raw
+    }
+
+    /// The unwrapped time of `raw`, or `None` if it would fall before zero (a record stamped
+    /// before the capture's first one, across a wrap).
+    pub(crate) fn peek(&self, raw: u32) -> Option<u64> {
+        match self.last_raw {
+            None => Some(u64::from(raw)),
+            Some(p) => u64::try_from(self.last_t + signed_step(p, raw)).ok(),
+        }
+    }
+
+    pub(crate) fn commit(&mut self, raw: u32, t_us: u64, stats: &mut IngestStats) {
+        let t = i64::try_from(t_us).unwrap_or(i64::MAX);
+        if self.last_raw.is_none() {
+            self.max_t = t;
+        } else if t > self.max_t {
+            let wraps = (t >> 32) - (self.max_t >> 32);
+            stats.clock_wraps += u64::try_from(wraps).unwrap_or(0);
+            self.max_t = t;
+        }
+        self.last_raw = Some(raw);
+        self.last_t = t;
+    }
+}
+
+/// Unwraps the 16-bit encoder count.
+#[derive(Debug, Default)]
+pub(crate) struct Counter {
+    last_raw: Option<i16>,
+    count: i64,
+}
+
+impl Counter {
+    /// The difference is taken mod 2^16 into [−32768, 32767]: a jump of 2^15 counts between two
+    /// samples (half of 8 revolutions in 1–5 ms) is physically impossible.
+    pub(crate) fn step(&mut self, raw: i16, stats: &mut IngestStats) -> i64 {
+        match self.last_raw {
+            None => self.count = i64::from(raw),
+            Some(p) => {
+                let d = i64::from(raw.wrapping_sub(p));
+                let sum = i64::from(p) + d;
+                if sum > i64::from(i16::MAX) || sum < i64::from(i16::MIN) {
+                    stats.encoder_wraps += 1;
+                }
+                self.count += d;
+            }
+        }
+        self.last_raw = Some(raw);
+        self.count
+    }
+}
+
+/// Gap detection for one stream.
+#[derive(Debug)]
+pub(crate) struct GapTracker {
+    stream: &'static str,
+    period_us: f64,
+    factor: f64,
+    last_t: Option<u64>,
+}
+
+impl GapTracker {
+    pub(crate) fn new(stream: &'static str, rate_hz: f64, factor: f64) -> Self {
+        Self {
+            stream,
+            period_us: 1e6 / rate_hz,
+            factor,
+            last_t: None,
+        }
+    }
+
+    pub(crate) fn last_t(&self) -> Option<u64> {
+        self.last_t
+    }
+
+    pub(crate) fn step(&mut self, t_us: u64, stats: &mut IngestStats) {
+        if let Some(prev) = self.last_t {
+            let dt = t_us.saturating_sub(prev) as f64;
+            if dt > self.factor * self.period_us {
+                let missing = ((dt / self.period_us).round() - 1.0).max(0.0);
+                stats.gap(Gap {
+                    stream: self.stream,
+                    after_t_us: prev,
+                    before_t_us: t_us,
+                    missing_samples_est: missing as u64,
+                });
+            }
+        }
+        self.last_t = Some(t_us);
+    }
+}
+
+/// A short, printable excerpt of a damaged input for messages.
+pub(crate) fn snippet(bytes: &[u8]) -> String {
+    const MAX: usize = 40;
+    let s = String::from_utf8_lossy(&bytes[..bytes.len().min(MAX)]);
+    let mut out: String = s.escape_debug().collect();
+    if bytes.len() > MAX {
+        out.push('…');
+    }
+    format!("\"{out}\"")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn theta_is_bin_centre() {
+        assert!((theta_rad(0, 4096) - 0.5 * TAU / 4096.0).abs() < 1e-15);
+        assert!((theta_rad(-1, 4096) + 0.5 * TAU / 4096.0).abs() < 1e-15);
+        assert!((theta_rad(4095, 4096) - (TAU - 0.5 * TAU / 4096.0)).abs() < 1e-12);
+    }
+
+    #[test]
+    fn clock_unwraps_and_counts_wraps() {
+        let mut stats = IngestStats::default();
+        let mut c = Clock::default();
+        let t0 = c.peek(u32::MAX - 10).unwrap();
+        c.commit(u32::MAX - 10, t0, &mut stats);
+        let t1 = c.peek(5).unwrap();
+        assert_eq!(t1, (1u64 << 32) + 5);
+        c.commit(5, t1, &mut stats);
+        assert_eq!(stats.clock_wraps, 1);
+        // slightly backwards across the wrap (another stream's stamp): no extra wrap
+        let t2 = c.peek(u32::MAX - 2).unwrap();
+        assert_eq!(t2, u64::from(u32::MAX - 2));
+        c.commit(u32::MAX - 2, t2, &mut stats);
+        let t3 = c.peek(100).unwrap();
+        c.commit(100, t3, &mut stats);
+        assert_eq!(stats.clock_wraps, 1);
+    }
+
+    #[test]
+    fn counter_unwraps() {
+        let mut stats = IngestStats::default();
+        let mut c = Counter::default();
+        assert_eq!(c.step(32760, &mut stats), 32760);
+        assert_eq!(c.step(-32766, &mut stats), 32770);
+        assert_eq!(c.step(32767, &mut stats), 32767);
+        assert_eq!(stats.encoder_wraps, 2);
+    }
+
+    #[test]
+    fn order_check() {
+        let r = OrderRule {
+            min_step_us: 1,
+            period_us: 100,
+            max_lone_step_us: 300,
+        };
+        assert!(check_order(Some(100), 200, &[300], r).is_ok());
+        assert!(check_order(Some(100), 90, &[300], r).is_err());
+        // outlier between good neighbours
+        assert!(check_order(Some(100), 90_000, &[300], r).is_err());
+        // the next one is the outlier: keep the candidate
+        assert!(check_order(Some(100), 200, &[50], r).is_ok());
+        assert!(check_order(Some(100), 200, &[120], r).is_ok());
+        // wrap
+        assert!(check_order(Some(u32::MAX - 5), 3, &[5000], r).is_ok());
+        // the last record
+        assert!(check_order(Some(100), 300, &[], r).is_ok());
+        // a gap followed by a steady stream, and two merged lines agreeing with each other
+        assert!(check_order(Some(100), 5_000, &[5_100, 5_200, 5_300], r).is_ok());
+        assert!(check_order(Some(100), 5_000, &[5_100, 300, 400], r).is_err());
+        assert!(check_order(Some(100), 90_000, &[], r).is_err());
+        // the first record
+        assert!(check_order(None, 100, &[200], r).is_ok());
+        assert!(check_order(None, 100, &[90_000], r).is_err());
+        assert!(check_order(None, 100, &[], r).is_ok());
+    }
+
+    #[test]
+    fn header_defaults_and_validation() {
+        let h = Header::new().with("x", "1");
+        assert_eq!(h.encoder_cpr(), 4096);
+        assert_eq!(h.accel_lsb_per_g(), 8192.0);
+        assert_eq!(h.sample_hz(), 200.0);
+        assert!(h.validate(Path::new("f")).is_ok());
+        let bad = Header::new().with("encoder_cpr", "zero");
+        let e = bad.validate(Path::new("f.csv")).unwrap_err().to_string();
+        assert!(e.contains("f.csv") && e.contains("encoder_cpr"), "{e}");
+    }
+}

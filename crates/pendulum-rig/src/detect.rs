@@ -1,0 +1,90 @@
+//! Opening a capture whose format is told by its content, not its name.
+
+use std::fs::File;
+use std::io::{BufRead, BufReader};
+use std::path::Path;
+
+use crate::capture::{Header, IngestStats, Location, ReadOptions, Sample};
+use crate::error::RigError;
+use crate::sd::{SdReader, SYNC};
+use crate::serial::{SerialReader, COLUMN_LINE};
+
+/// A capture of either format, opened from a file.
+pub enum CaptureReader {
+    Serial(SerialReader<BufReader<File>>),
+    Sd(SdReader<BufReader<File>>),
+}
+
+impl CaptureReader {
+    /// Opens `path` and detects its format: `A5 5A` first → `sd-v2`; text starting (after
+    /// blank space) with `#` or the column line → `serial-v1`; anything else is
+    /// [`RigError::NotACapture`].
+    pub fn open(path: impl AsRef<Path>, opts: ReadOptions) -> Result<Self, RigError> {
+        let path = path.as_ref();
+        let file = File::open(path).map_err(|e| RigError::io(path, e))?;
+        let mut reader = BufReader::with_capacity(64 * 1024, file);
+        let head = loop {
+            match reader.fill_buf() {
+                Ok(b) => break b,
+                Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+                Err(e) => return Err(RigError::io(path, e)),
+            }
+        };
+        if head.starts_with(&SYNC) {
+            return Ok(CaptureReader::Sd(SdReader::new(reader, path, opts)?));
+        }
+        let text = head.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(head);
+        let first = text
+            .iter()
+            .position(|b| !b.is_ascii_whitespace())
+            .map(|i| &text[i..]);
+        let serial = match first {
+            Some(t) => t.starts_with(b"#") || t.starts_with(b"t_us"),
+            // Only blank space so far: let the serial reader say what is wrong.
+            None => !head.is_empty(),
+        };
+        if serial {
+            return Ok(CaptureReader::Serial(SerialReader::new(
+                reader, path, opts,
+            )?));
+        }
+        Err(RigError::NotACapture {
+            path: path.to_path_buf(),
+            at: Location::Byte(0),
+            reason: format!(
+                "expected an sd-v2 capture (bytes A5 5A) or a serial-v1 capture (a `#` header \
+                 line or the column line `{COLUMN_LINE}`)"
+            ),
+        })
+    }
+
+    /// `"serial-v1"` or `"sd-v2"`.
+    pub fn format(&self) -> &'static str {
+        match self {
+            CaptureReader::Serial(_) => "serial-v1",
+            CaptureReader::Sd(_) => "sd-v2",
+        }
+    }
+
+    /// See [`SerialReader::next_sample`] and [`SdReader::next_sample`].
+    pub fn next_sample(&mut self) -> Result<Option<Sample>, RigError> {
+        match self {
+            CaptureReader::Serial(r) => r.next_sample(),
+            CaptureReader::Sd(r) => r.next_sample(),
+        }
+    }
+
+    pub fn header(&self) -> &Header {
+        match self {
+            CaptureReader::Serial(r) => r.header(),
+            CaptureReader::Sd(r) => r.header(),
+        }
+    }
+
+    pub fn stats(&self) -> &IngestStats {
+        match self {
+            CaptureReader::Serial(r) => r.stats(),
+            CaptureReader::Sd(r) => r.stats(),
+        }
+    }
+}

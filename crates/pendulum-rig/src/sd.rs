@@ -1,0 +1,614 @@
+//! The binary SD-card capture (`*.bin`, firmware `sd-v2`): reader and writer.
+//!
+//! Frame: `A5 5A | type | n | t_us (u32 LE) | payload (n bytes) | CRC-8 over type..payload`.
+//! The reader keeps a bounded buffer (one read chunk plus one frame), resynchronises after
+//! damage on the next sync whose frame has a valid CRC, and reports what it dropped.
+
+use std::collections::VecDeque;
+use std::io::{self, Read, Write};
+use std::path::{Path, PathBuf};
+
+use crate::capture::{
+    accel_si, check_order, theta_rad, AccelSample, Clock, Counter, EncoderSample, GapTracker,
+    Header, IngestStats, Location, OrderRule, ReadOptions, Sample, CONFIRM_RECORDS,
+};
+use crate::crc8::crc8;
+use crate::error::RigError;
+
+/// Frame start marker.
+pub const SYNC: [u8; 2] = [0xA5, 0x5A];
+pub const FRAME_ENCODER: u8 = 1;
+pub const FRAME_ACCEL: u8 = 2;
+pub const FRAME_HEADER: u8 = 3;
+/// Sync, type, length, t_us and CRC: a frame is `FRAME_OVERHEAD + n` bytes.
+pub const FRAME_OVERHEAD: usize = 9;
+
+/// Accelerometer stamps are compensated for the filter delay, so an accel frame may be stamped
+/// a few ms before the encoder frame written just before it: steps down to −50 ms between
+/// frames of different streams are still "in order" for outlier rejection.
+const MAX_CROSS_STREAM_SKEW_US: i64 = 50_000;
+/// Encoder speed bound for frames that pass the CRC but are not followed by a sync (see
+/// [`Frame::suspect`]): 128 counts/ms is 31 rev/s, far above anything the pendulum does.
+const MAX_SUSPECT_COUNTS_PER_MS: i64 = 128;
+/// Accelerometer step bound for such frames: 1 g between two samples (the shaker changes the
+/// acceleration by about 0.3 g per 5 ms at most).
+const MAX_SUSPECT_ACCEL_STEP: i32 = 8192;
+const READ_CHUNK: usize = 16 * 1024;
+
+/// Builds one frame. A payload longer than 255 bytes is cut to 255 (the length is one byte).
+pub fn encode_frame(kind: u8, t_us: u32, payload: &[u8]) -> Vec<u8> {
+    let payload = &payload[..payload.len().min(255)];
+    let mut f = Vec::with_capacity(FRAME_OVERHEAD + payload.len());
+    f.extend_from_slice(&SYNC);
+    f.push(kind);
+    f.push(payload.len() as u8);
+    f.extend_from_slice(&t_us.to_le_bytes());
+    f.extend_from_slice(payload);
+    let crc = crc8(&f[2..]);
+    f.push(crc);
+    f
+}
+
+fn valid_kind_len(kind: u8, n: u8) -> bool {
+    matches!(
+        (kind, n),
+        (FRAME_ENCODER, 2) | (FRAME_ACCEL, 6) | (FRAME_HEADER, _)
+    )
+}
+
+/// A frame that passed sync, type/length and CRC checks.
+struct Frame {
+    offset: u64,
+    kind: u8,
+    len: u64,
+    t_us: u32,
+    payload: [u8; 6],
+    suspect: Suspect,
+}
+
+/// Whether a frame that passed its CRC still needs a plausibility check.
+///
+/// A frame whose bytes were shifted by an insertion or deletion passes the 8-bit CRC by chance
+/// 1 time in 256; it then mostly ends off the frame grid (not followed by a sync), so such
+/// frames must also look plausible next to the last sample of their stream.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Suspect {
+    /// Followed by a sync.
+    No,
+    /// The last frame of the file: checked if its stream has an earlier sample.
+    AtEnd,
+    /// Followed by something else: checked, and dropped if its stream has no earlier sample.
+    OffGrid,
+}
+
+impl Frame {
+    fn i16_at(&self, i: usize) -> i16 {
+        i16::from_le_bytes([self.payload[2 * i], self.payload[2 * i + 1]])
+    }
+}
+
+/// Bytes being dropped since the last valid frame.
+struct DropRun {
+    start: u64,
+    len: u64,
+    reason: &'static str,
+}
+
+/// Streaming reader of an SD capture.
+pub struct SdReader<R: Read> {
+    inner: R,
+    path: PathBuf,
+    opts: ReadOptions,
+    header: Header,
+    cpr: u32,
+    lsb_per_g: f64,
+    order: OrderRule,
+    buf: Vec<u8>,
+    start: usize,
+    buf_offset: u64,
+    eof: bool,
+    dropping: Option<DropRun>,
+    tail_start: Option<u64>,
+    finished: bool,
+    lookahead: VecDeque<Frame>,
+    /// The record source is exhausted.
+    drained: bool,
+    clock: Clock,
+    counter: Counter,
+    enc_gaps: GapTracker,
+    acc_gaps: GapTracker,
+    last_enc: Option<(u64, i16)>,
+    last_acc: Option<(u64, [i16; 3])>,
+    stats: IngestStats,
+}
+
+impl<R: Read> SdReader<R> {
+    /// Reads the header frame, which must start the file. `path` is only used in messages.
+    pub fn new(inner: R, path: impl AsRef<Path>, opts: ReadOptions) -> Result<Self, RigError> {
+        let mut me = Self {
+            inner,
+            path: path.as_ref().to_path_buf(),
+            opts,
+            header: Header::new(),
+            cpr: 0,
+            lsb_per_g: 0.0,
+            order: OrderRule {
+                min_step_us: -MAX_CROSS_STREAM_SKEW_US,
+                period_us: 1000,
+                max_lone_step_us: MAX_CROSS_STREAM_SKEW_US,
+            },
+            buf: Vec::with_capacity(READ_CHUNK + 512),
+            start: 0,
+            buf_offset: 0,
+            eof: false,
+            dropping: None,
+            tail_start: None,
+            finished: false,
+            lookahead: VecDeque::with_capacity(CONFIRM_RECORDS + 1),
+            drained: false,
+            clock: Clock::default(),
+            counter: Counter::default(),
+            enc_gaps: GapTracker::new("encoder", 1.0, 1.0),
+            acc_gaps: GapTracker::new("accel", 1.0, 1.0),
+            last_enc: None,
+            last_acc: None,
+            stats: IngestStats::default(),
+        };
+        me.read_header()?;
+        me.header.validate(&me.path)?;
+        me.cpr = me.header.encoder_cpr();
+        me.lsb_per_g = me.header.accel_lsb_per_g();
+        me.enc_gaps = GapTracker::new("encoder", me.header.encoder_hz(), opts.gap_factor);
+        me.acc_gaps = GapTracker::new("accel", me.header.accel_hz(), opts.gap_factor);
+        let slowest_period_us = 1e6 / me.header.encoder_hz().min(me.header.accel_hz());
+        me.order = OrderRule {
+            min_step_us: -MAX_CROSS_STREAM_SKEW_US,
+            period_us: (1e6 / me.header.encoder_hz()).round() as i64,
+            max_lone_step_us: (opts.gap_factor.max(1.0) * slowest_period_us).round() as i64
+                + MAX_CROSS_STREAM_SKEW_US,
+        };
+        Ok(me)
+    }
+
+    pub fn header(&self) -> &Header {
+        &self.header
+    }
+
+    pub fn stats(&self) -> &IngestStats {
+        &self.stats
+    }
+
+    fn not_a_capture(&self, at: u64, reason: &str) -> RigError {
+        RigError::NotACapture {
+            path: self.path.clone(),
+            at: Location::Byte(at),
+            reason: reason.to_string(),
+        }
+    }
+
+    fn read_header(&mut self) -> Result<(), RigError> {
+        let avail = self.fill(4)?;
+        let b = &self.buf[self.start..];
+        if avail < 2 || b[..2] != SYNC {
+            return Err(self.not_a_capture(0, "expected the sd-v2 sync bytes A5 5A"));
+        }
+        if avail < 4 || b[2] != FRAME_HEADER {
+            return Err(self.not_a_capture(2, "expected a header frame (type 3) first"));
+        }
+        let total = FRAME_OVERHEAD + usize::from(b[3]);
+        if self.fill(total)? < total {
+            return Err(self.not_a_capture(0, "header frame cut short by the end of the file"));
+        }
+        let f = &self.buf[self.start..self.start + total];
+        if crc8(&f[2..total - 1]) != f[total - 1] {
+            return Err(self.not_a_capture((total - 1) as u64, "header frame CRC mismatch"));
+        }
+        let text = String::from_utf8_lossy(&f[8..total - 1]).into_owned();
+        for line in text.lines() {
+            if let Some((k, v)) = line.split_once('=') {
+                let k = k.trim();
+                if !k.is_empty() {
+                    self.header
+                        .entries
+                        .push((k.to_string(), v.trim().to_string()));
+                }
+            }
+        }
+        self.start += total;
+        Ok(())
+    }
+
+    /// Makes at least `k` bytes available if the file has them; returns how many are.
+    fn fill(&mut self, k: usize) -> Result<usize, RigError> {
+        while self.buf.len() - self.start < k && !self.eof {
+            if self.start > 0 {
+                self.buf.drain(..self.start);
+                self.buf_offset += self.start as u64;
+                self.start = 0;
+            }
+            let old = self.buf.len();
+            self.buf.resize(old + READ_CHUNK, 0);
+            let got = self.inner.read(&mut self.buf[old..]);
+            match got {
+                Ok(0) => {
+                    self.buf.truncate(old);
+                    self.eof = true;
+                }
+                Ok(n) => self.buf.truncate(old + n),
+                Err(e) if e.kind() == io::ErrorKind::Interrupted => self.buf.truncate(old),
+                Err(e) => {
+                    self.buf.truncate(old);
+                    return Err(RigError::io(&self.path, e));
+                }
+            }
+        }
+        Ok(self.buf.len() - self.start)
+    }
+
+    fn pos(&self) -> u64 {
+        self.buf_offset + self.start as u64
+    }
+
+    fn drop_bytes(&mut self, n: usize, reason: &'static str) {
+        let pos = self.pos();
+        let run = self.dropping.get_or_insert(DropRun {
+            start: pos,
+            len: 0,
+            reason,
+        });
+        run.len += n as u64;
+        self.start += n;
+    }
+
+    /// A frame cut by the end of the file may start here.
+    fn mark_tail(&mut self) {
+        if self.tail_start.is_none() {
+            self.tail_start = Some(self.pos());
+        }
+    }
+
+    fn flush_drop(&mut self) {
+        if let Some(run) = self.dropping.take() {
+            let reason = format!("{} bytes dropped ({})", run.len, run.reason);
+            self.stats.skip(Location::Byte(run.start), reason, run.len);
+        }
+    }
+
+    /// At the end of the file: bytes from a cut last frame are the truncated tail, anything
+    /// dropped before them is a skip.
+    fn finish_tail(&mut self) {
+        if self.finished {
+            return;
+        }
+        self.finished = true;
+        let end = self.pos();
+        if let Some(t) = self.tail_start.take() {
+            self.stats.truncated_tail_bytes = end.saturating_sub(t);
+            if let Some(run) = self.dropping.as_mut() {
+                run.len = t.saturating_sub(run.start);
+                if run.len == 0 {
+                    self.dropping = None;
+                }
+            }
+        }
+        self.flush_drop();
+    }
+
+    /// The next frame that passes sync, type/length and CRC checks.
+    fn next_frame(&mut self) -> Result<Option<Frame>, RigError> {
+        loop {
+            let avail = self.fill(2)?;
+            if avail == 0 {
+                self.finish_tail();
+                return Ok(None);
+            }
+            let s = self.start;
+            if self.buf[s] != SYNC[0] {
+                let run = self.buf[s..]
+                    .iter()
+                    .position(|&b| b == SYNC[0])
+                    .unwrap_or(avail);
+                self.drop_bytes(run.max(1), "no sync");
+                continue;
+            }
+            if avail < 2 {
+                self.mark_tail();
+                self.drop_bytes(1, "cut short");
+                continue;
+            }
+            if self.buf[s + 1] != SYNC[1] {
+                self.drop_bytes(1, "no sync");
+                continue;
+            }
+            if self.fill(4)? < 4 {
+                self.mark_tail();
+                self.drop_bytes(1, "cut short");
+                continue;
+            }
+            let s = self.start;
+            let (kind, n) = (self.buf[s + 2], self.buf[s + 3]);
+            if !valid_kind_len(kind, n) {
+                self.drop_bytes(1, "bad frame type or length");
+                continue;
+            }
+            let total = FRAME_OVERHEAD + usize::from(n);
+            let avail = self.fill(total + 2)?;
+            if avail < total {
+                self.mark_tail();
+                self.drop_bytes(1, "cut short");
+                continue;
+            }
+            let s = self.start;
+            let f = &self.buf[s..s + total];
+            if crc8(&f[2..total - 1]) != f[total - 1] {
+                self.drop_bytes(1, "bad CRC");
+                continue;
+            }
+            let after = &self.buf[s + total..s + avail.min(total + 2)];
+            let suspect = match after.len() {
+                0 => Suspect::AtEnd,
+                1 if after[0] != SYNC[0] => Suspect::OffGrid,
+                n if n >= 2 && after[..2] != SYNC => Suspect::OffGrid,
+                _ => Suspect::No,
+            };
+            let t_us = u32::from_le_bytes([f[4], f[5], f[6], f[7]]);
+            let mut payload = [0u8; 6];
+            if kind != FRAME_HEADER {
+                payload[..usize::from(n)].copy_from_slice(&f[8..8 + usize::from(n)]);
+            }
+            self.tail_start = None;
+            self.flush_drop();
+            let frame = Frame {
+                offset: self.pos(),
+                kind,
+                len: total as u64,
+                t_us,
+                payload,
+                suspect,
+            };
+            self.start += total;
+            return Ok(Some(frame));
+        }
+    }
+
+    /// The next encoder or accelerometer frame; header frames after the first are skipped.
+    fn next_data_frame(&mut self) -> Result<Option<Frame>, RigError> {
+        loop {
+            match self.next_frame()? {
+                Some(f) if f.kind == FRAME_HEADER => {
+                    self.stats.skip(
+                        Location::Byte(f.offset),
+                        "header frame after the start of the file ignored",
+                        f.len,
+                    );
+                }
+                other => return Ok(other),
+            }
+        }
+    }
+
+    /// Plausibility of a suspect frame next to the last kept sample of its stream.
+    fn plausible(&self, f: &Frame, t_us: u64) -> bool {
+        if f.suspect == Suspect::No {
+            return true;
+        }
+        let alone = f.suspect == Suspect::AtEnd;
+        if f.kind == FRAME_ENCODER {
+            match self.last_enc {
+                None => alone,
+                Some((t0, c0)) => {
+                    let dt_ms = i64::try_from(t_us.saturating_sub(t0) / 1000).unwrap_or(i64::MAX);
+                    let limit = MAX_SUSPECT_COUNTS_PER_MS.saturating_mul(dt_ms.max(1));
+                    i64::from(f.i16_at(0).wrapping_sub(c0)).abs() <= limit
+                }
+            }
+        } else {
+            match self.last_acc {
+                None => alone,
+                Some((_, a0)) => (0..3).all(|i| {
+                    (i32::from(f.i16_at(i)) - i32::from(a0[i])).abs() <= MAX_SUSPECT_ACCEL_STEP
+                }),
+            }
+        }
+    }
+
+    /// The next sample, in file order. Errors only on I/O failure; damage is skipped and
+    /// counted in [`Self::stats`].
+    pub fn next_sample(&mut self) -> Result<Option<Sample>, RigError> {
+        loop {
+            while self.lookahead.len() <= CONFIRM_RECORDS && !self.drained {
+                match self.next_data_frame()? {
+                    Some(x) => self.lookahead.push_back(x),
+                    None => self.drained = true,
+                }
+            }
+            let Some(cand) = self.lookahead.pop_front() else {
+                return Ok(None);
+            };
+            let mut next = [0u32; CONFIRM_RECORDS];
+            for (slot, x) in next.iter_mut().zip(&self.lookahead) {
+                *slot = x.t_us;
+            }
+            let verdict = check_order(
+                self.clock.last_raw(),
+                cand.t_us,
+                &next[..self.lookahead.len()],
+                self.order,
+            );
+            let at = Location::Byte(cand.offset);
+            if let Err(why) = verdict {
+                let reason = format!("frame with valid CRC dropped: {why} (t_us={})", cand.t_us);
+                self.stats.skip(at, reason, cand.len);
+                continue;
+            }
+            let Some(t_us) = self.clock.peek(cand.t_us) else {
+                self.stats
+                    .skip(at, "time before the capture start", cand.len);
+                continue;
+            };
+            let (stream_last, name) = if cand.kind == FRAME_ENCODER {
+                (self.enc_gaps.last_t(), "encoder")
+            } else {
+                (self.acc_gaps.last_t(), "accel")
+            };
+            if stream_last.is_some_and(|last| t_us <= last) {
+                let reason = format!("time goes backwards in the {name} stream: garbled");
+                self.stats.skip(at, reason, cand.len);
+                continue;
+            }
+            if !self.plausible(&cand, t_us) {
+                let reason = format!(
+                    "frame with valid CRC but off the frame grid and implausible {name} value"
+                );
+                self.stats.skip(at, reason, cand.len);
+                continue;
+            }
+            self.clock.commit(cand.t_us, t_us, &mut self.stats);
+            if cand.kind == FRAME_ENCODER {
+                let count_raw = cand.i16_at(0);
+                self.enc_gaps.step(t_us, &mut self.stats);
+                let count = self.counter.step(count_raw, &mut self.stats);
+                self.last_enc = Some((t_us, count_raw));
+                self.stats.encoder_samples += 1;
+                return Ok(Some(Sample::Encoder(EncoderSample {
+                    t_us_raw: cand.t_us,
+                    t_us,
+                    count_raw,
+                    count,
+                    theta_rad: theta_rad(count, self.cpr),
+                })));
+            }
+            let raw = [cand.i16_at(0), cand.i16_at(1), cand.i16_at(2)];
+            self.acc_gaps.step(t_us, &mut self.stats);
+            self.last_acc = Some((t_us, raw));
+            self.stats.accel_samples += 1;
+            return Ok(Some(Sample::Accel(AccelSample {
+                t_us_raw: cand.t_us,
+                t_us,
+                raw,
+                si_m_s2: accel_si(raw, self.lsb_per_g, self.opts.g_m_s2),
+            })));
+        }
+    }
+}
+
+/// Writes an SD capture as the `sd-v2` firmware does (used by the twin and by tests).
+pub struct SdWriter<W: Write> {
+    w: W,
+}
+
+impl<W: Write> SdWriter<W> {
+    /// Writes the header frame (`key=value\n` lines, stamped t_us = 0). Fails with
+    /// `InvalidInput` if the header text does not fit in one frame (255 bytes).
+    pub fn new(mut w: W, header: &Header) -> io::Result<Self> {
+        let mut text = String::new();
+        for (k, v) in &header.entries {
+            let k: String = k
+                .chars()
+                .map(|c| if c == '=' || c.is_control() { '_' } else { c })
+                .collect();
+            let v: String = v
+                .chars()
+                .map(|c| if c.is_control() { ' ' } else { c })
+                .collect();
+            text.push_str(&format!("{k}={v}\n"));
+        }
+        if text.len() > 255 {
+            return Err(io::Error::new(
+                io::ErrorKind::InvalidInput,
+                format!("sd-v2 header text is {} bytes, at most 255 fit", text.len()),
+            ));
+        }
+        w.write_all(&encode_frame(FRAME_HEADER, 0, text.as_bytes()))?;
+        Ok(Self { w })
+    }
+
+    pub fn write_encoder(&mut self, t_us_raw: u32, count_raw: i16) -> io::Result<()> {
+        self.w.write_all(&encode_frame(
+            FRAME_ENCODER,
+            t_us_raw,
+            &count_raw.to_le_bytes(),
+        ))
+    }
+
+    pub fn write_accel(&mut self, t_us_raw: u32, raw: [i16; 3]) -> io::Result<()> {
+        let mut p = [0u8; 6];
+        for (i, v) in raw.iter().enumerate() {
+            p[2 * i..2 * i + 2].copy_from_slice(&v.to_le_bytes());
+        }
+        self.w.write_all(&encode_frame(FRAME_ACCEL, t_us_raw, &p))
+    }
+
+    /// Writes bytes verbatim: for injecting damage.
+    pub fn write_raw(&mut self, bytes: &[u8]) -> io::Result<()> {
+        self.w.write_all(bytes)
+    }
+
+    /// Flushes and returns the inner writer.
+    pub fn finish(mut self) -> io::Result<W> {
+        self.w.flush()?;
+        Ok(self.w)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn capture() -> Vec<u8> {
+        let mut w = SdWriter::new(Vec::new(), &Header::sd_v2()).unwrap();
+        for i in 0..20u32 {
+            w.write_encoder(1000 * i, i as i16).unwrap();
+            if i % 5 == 0 {
+                w.write_accel(1000 * i, [1, 2, 8192]).unwrap();
+            }
+        }
+        w.finish().unwrap()
+    }
+
+    fn read_all(bytes: &[u8]) -> (Vec<Sample>, IngestStats) {
+        let mut r = SdReader::new(bytes, "t.bin", ReadOptions::default()).unwrap();
+        let mut v = Vec::new();
+        while let Some(s) = r.next_sample().unwrap() {
+            v.push(s);
+        }
+        (v, r.stats().clone())
+    }
+
+    #[test]
+    fn frame_layout() {
+        let f = encode_frame(FRAME_ENCODER, 0x0403_0201, &[0xFF, 0x7F]);
+        assert_eq!(&f[..8], &[0xA5, 0x5A, 1, 2, 1, 2, 3, 4]);
+        assert_eq!(&f[8..10], &[0xFF, 0x7F]);
+        assert_eq!(f[10], crc8(&f[2..10]));
+    }
+
+    #[test]
+    fn reads_back() {
+        let (v, st) = read_all(&capture());
+        assert_eq!(v.len(), 24);
+        assert_eq!(st.encoder_samples, 20);
+        assert_eq!(st.accel_samples, 4);
+        assert_eq!(st.skipped_lines_or_frames, 0);
+        assert_eq!(st.gap_count, 0);
+    }
+
+    #[test]
+    fn truncated_tail_is_counted() {
+        let bytes = capture();
+        let cut = &bytes[..bytes.len() - 4];
+        let (v, st) = read_all(cut);
+        assert_eq!(v.len(), 23);
+        assert_eq!(st.truncated_tail_bytes, 11 - 4);
+        assert_eq!(st.skipped_bytes, 0);
+    }
+
+    #[test]
+    fn not_a_capture_names_path_and_offset() {
+        let e = SdReader::new(&b"\xA5\x5A\x01\x02"[..], "z.bin", ReadOptions::default())
+            .err()
+            .unwrap()
+            .to_string();
+        assert!(e.contains("z.bin") && e.contains("byte 2"), "{e}");
+    }
+}

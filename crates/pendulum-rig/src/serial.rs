@@ -1,0 +1,485 @@
+//! The serial text capture (`*.csv`, firmware `serial-v1`): reader and writer.
+//!
+//! The reader streams line by line with a bounded line buffer, so memory does not grow with the
+//! file (nor with a "line" of binary garbage that never ends).
+
+use std::collections::VecDeque;
+use std::io::{self, BufRead, Write};
+use std::path::{Path, PathBuf};
+
+use crate::capture::{
+    accel_si, check_order, snippet, theta_rad, AccelSample, Clock, Counter, EncoderSample,
+    GapTracker, Header, IngestStats, Location, OrderRule, ReadOptions, Sample, CONFIRM_RECORDS,
+};
+use crate::error::RigError;
+
+/// The column line that ends the header.
+pub const COLUMN_LINE: &str = "t_us,enc,ax,ay,az";
+
+/// Longer lines are garbage: a real sample line is at most ~40 bytes.
+const MAX_LINE_BYTES: usize = 1024;
+
+/// One line as read: content in the reader's buffer (without `\n`/`\r\n`), capped at
+/// [`MAX_LINE_BYTES`].
+struct LineInfo {
+    number: u64,
+    /// Bytes in the file, line end included.
+    bytes: u64,
+    overlong: bool,
+    terminated: bool,
+}
+
+/// A syntactically valid data line, not yet accepted.
+struct Row {
+    line: u64,
+    bytes: u64,
+    t_us: u32,
+    enc: i16,
+    accel: [i16; 3],
+}
+
+/// Streaming reader of a serial capture.
+pub struct SerialReader<R: BufRead> {
+    reader: R,
+    path: PathBuf,
+    opts: ReadOptions,
+    header: Header,
+    cpr: u32,
+    lsb_per_g: f64,
+    order: OrderRule,
+    line_no: u64,
+    line: Vec<u8>,
+    lookahead: VecDeque<Row>,
+    /// The record source is exhausted.
+    drained: bool,
+    pending_accel: Option<AccelSample>,
+    clock: Clock,
+    counter: Counter,
+    gaps: GapTracker,
+    stats: IngestStats,
+}
+
+impl<R: BufRead> SerialReader<R> {
+    /// Reads the `#` header and the column line. `path` is only used in messages.
+    pub fn new(reader: R, path: impl AsRef<Path>, opts: ReadOptions) -> Result<Self, RigError> {
+        let path = path.as_ref().to_path_buf();
+        let mut me = Self {
+            reader,
+            path,
+            opts,
+            header: Header::new(),
+            cpr: 0,
+            lsb_per_g: 0.0,
+            order: OrderRule {
+                min_step_us: 1,
+                period_us: 5000,
+                max_lone_step_us: 15_000,
+            },
+            line_no: 0,
+            line: Vec::with_capacity(128),
+            lookahead: VecDeque::with_capacity(CONFIRM_RECORDS + 1),
+            drained: false,
+            pending_accel: None,
+            clock: Clock::default(),
+            counter: Counter::default(),
+            gaps: GapTracker::new("serial", 1.0, 1.0),
+            stats: IngestStats::default(),
+        };
+        me.read_header()?;
+        me.header.validate(&me.path)?;
+        me.cpr = me.header.encoder_cpr();
+        me.lsb_per_g = me.header.accel_lsb_per_g();
+        me.gaps = GapTracker::new("serial", me.header.sample_hz(), opts.gap_factor);
+        let period_us = 1e6 / me.header.sample_hz();
+        me.order = OrderRule {
+            min_step_us: 1,
+            period_us: period_us.round() as i64,
+            max_lone_step_us: (opts.gap_factor.max(1.0) * period_us).round() as i64,
+        };
+        Ok(me)
+    }
+
+    pub fn header(&self) -> &Header {
+        &self.header
+    }
+
+    pub fn stats(&self) -> &IngestStats {
+        &self.stats
+    }
+
+    fn not_a_capture(&self, line: u64, reason: String) -> RigError {
+        RigError::NotACapture {
+            path: self.path.clone(),
+            at: Location::Line(line),
+            reason,
+        }
+    }
+
+    fn read_header(&mut self) -> Result<(), RigError> {
+        let mut seen_header = false;
+        loop {
+            let Some(info) = self.read_line()? else {
+                let reason = if seen_header {
+                    format!("the file ends before the column line `{COLUMN_LINE}`")
+                } else {
+                    "the file is empty".to_string()
+                };
+                return Err(self.not_a_capture(self.line_no.max(1), reason));
+            };
+            if info.overlong {
+                return Err(self.not_a_capture(
+                    info.number,
+                    format!("header line longer than {MAX_LINE_BYTES} bytes"),
+                ));
+            }
+            let mut content: &[u8] = &self.line;
+            if info.number == 1 {
+                content = content.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(content);
+            }
+            let text = String::from_utf8_lossy(content);
+            let text = text.trim();
+            if text.is_empty() {
+                continue;
+            }
+            if let Some(rest) = text.strip_prefix('#') {
+                seen_header = true;
+                // A `#` line without `=` is a comment.
+                if let Some((k, v)) = rest.split_once('=') {
+                    let k = k.trim();
+                    if !k.is_empty() {
+                        self.header
+                            .entries
+                            .push((k.to_string(), v.trim().to_string()));
+                    }
+                }
+                continue;
+            }
+            let columns: String = text.chars().filter(|c| !c.is_whitespace()).collect();
+            if columns == COLUMN_LINE {
+                return Ok(());
+            }
+            let reason = if seen_header {
+                format!(
+                    "expected the column line `{COLUMN_LINE}` after the header, found {}",
+                    snippet(text.as_bytes())
+                )
+            } else {
+                format!(
+                    "expected a `#` header line or the column line `{COLUMN_LINE}`, found {}",
+                    snippet(text.as_bytes())
+                )
+            };
+            return Err(self.not_a_capture(info.number, reason));
+        }
+    }
+
+    /// Reads one line into `self.line`, keeping at most [`MAX_LINE_BYTES`] of it.
+    fn read_line(&mut self) -> Result<Option<LineInfo>, RigError> {
+        self.line.clear();
+        let mut bytes = 0u64;
+        let mut overlong = false;
+        let mut terminated = false;
+        loop {
+            let avail = match self.reader.fill_buf() {
+                Ok(b) => b,
+                Err(e) if e.kind() == io::ErrorKind::Interrupted => continue,
+                Err(e) => return Err(RigError::io(&self.path, e)),
+            };
+            if avail.is_empty() {
+                break;
+            }
+            let (chunk, used) = match avail.iter().position(|&b| b == b'\n') {
+                Some(i) => {
+                    terminated = true;
+                    (&avail[..i], i + 1)
+                }
+                None => (avail, avail.len()),
+            };
+            let room = MAX_LINE_BYTES.saturating_sub(self.line.len());
+            if chunk.len() > room {
+                overlong = true;
+            }
+            self.line.extend_from_slice(&chunk[..chunk.len().min(room)]);
+            self.reader.consume(used);
+            bytes += used as u64;
+            if terminated {
+                break;
+            }
+        }
+        if bytes == 0 {
+            return Ok(None);
+        }
+        if self.line.last() == Some(&b'\r') {
+            self.line.pop();
+        }
+        self.line_no += 1;
+        Ok(Some(LineInfo {
+            number: self.line_no,
+            bytes,
+            overlong,
+            terminated,
+        }))
+    }
+
+    /// The next syntactically valid data line; damaged ones are recorded and skipped.
+    fn next_row(&mut self) -> Result<Option<Row>, RigError> {
+        loop {
+            let Some(info) = self.read_line()? else {
+                return Ok(None);
+            };
+            if info.overlong {
+                self.stats.skip(
+                    Location::Line(info.number),
+                    format!("line longer than {MAX_LINE_BYTES} bytes (garbage)"),
+                    info.bytes,
+                );
+                continue;
+            }
+            // Blank lines (a terminal program's doing) carry nothing: ignored, not counted.
+            if self.line.iter().all(|b| b.is_ascii_whitespace()) {
+                continue;
+            }
+            if !info.terminated {
+                // Every line the firmware sends ends with `\n`: without it the line may have
+                // been cut inside its last field, which would still parse.
+                let reason = format!(
+                    "last line has no line end (cut short): {}",
+                    snippet(&self.line)
+                );
+                self.stats
+                    .skip(Location::Line(info.number), reason, info.bytes);
+                continue;
+            }
+            match parse_row(&self.line) {
+                Ok((t_us, enc, accel)) => {
+                    return Ok(Some(Row {
+                        line: info.number,
+                        bytes: info.bytes,
+                        t_us,
+                        enc,
+                        accel,
+                    }))
+                }
+                Err(why) => {
+                    let reason = format!("{why}: {}", snippet(&self.line));
+                    self.stats
+                        .skip(Location::Line(info.number), reason, info.bytes);
+                }
+            }
+        }
+    }
+
+    /// The next sample: for each good line its encoder sample, then its accelerometer sample.
+    /// Errors only on I/O failure; damaged lines are skipped and counted in [`Self::stats`].
+    pub fn next_sample(&mut self) -> Result<Option<Sample>, RigError> {
+        if let Some(a) = self.pending_accel.take() {
+            return Ok(Some(Sample::Accel(a)));
+        }
+        loop {
+            while self.lookahead.len() <= CONFIRM_RECORDS && !self.drained {
+                match self.next_row()? {
+                    Some(x) => self.lookahead.push_back(x),
+                    None => self.drained = true,
+                }
+            }
+            let Some(cand) = self.lookahead.pop_front() else {
+                return Ok(None);
+            };
+            let mut next = [0u32; CONFIRM_RECORDS];
+            for (slot, x) in next.iter_mut().zip(&self.lookahead) {
+                *slot = x.t_us;
+            }
+            let verdict = check_order(
+                self.clock.last_raw(),
+                cand.t_us,
+                &next[..self.lookahead.len()],
+                self.order,
+            );
+            let t_us = match (verdict, self.clock.peek(cand.t_us)) {
+                (Ok(()), Some(t)) => t,
+                (Err(why), _) => {
+                    let reason = format!("{why} (t_us={}): garbled", cand.t_us);
+                    self.stats
+                        .skip(Location::Line(cand.line), reason, cand.bytes);
+                    continue;
+                }
+                (Ok(()), None) => {
+                    self.stats.skip(
+                        Location::Line(cand.line),
+                        "time before the capture start",
+                        cand.bytes,
+                    );
+                    continue;
+                }
+            };
+            self.clock.commit(cand.t_us, t_us, &mut self.stats);
+            self.gaps.step(t_us, &mut self.stats);
+            let count = self.counter.step(cand.enc, &mut self.stats);
+            self.stats.encoder_samples += 1;
+            self.stats.accel_samples += 1;
+            self.pending_accel = Some(AccelSample {
+                t_us_raw: cand.t_us,
+                t_us,
+                raw: cand.accel,
+                si_m_s2: accel_si(cand.accel, self.lsb_per_g, self.opts.g_m_s2),
+            });
+            return Ok(Some(Sample::Encoder(EncoderSample {
+                t_us_raw: cand.t_us,
+                t_us,
+                count_raw: cand.enc,
+                count,
+                theta_rad: theta_rad(count, self.cpr),
+            })));
+        }
+    }
+}
+
+/// Parses `t_us,enc,ax,ay,az`. Strict on purpose: anything the firmware would not have written
+/// (signs on t, `+`, digits run together beyond the type's range, extra fields) is damage.
+fn parse_row(line: &[u8]) -> Result<(u32, i16, [i16; 3]), String> {
+    let fields: Vec<&[u8]> = line.split(|&b| b == b',').collect();
+    if fields.len() != 5 {
+        let hint = if fields.len() > 5 {
+            "lines run together?"
+        } else {
+            "cut short?"
+        };
+        return Err(format!("{} fields, expected 5 ({hint})", fields.len()));
+    }
+    let t = parse_int(fields[0], false)
+        .filter(|v| *v <= i64::from(u32::MAX))
+        .ok_or_else(|| field_error("t_us", "an integer in 0..=4294967295"))?;
+    let mut vals = [0i16; 4];
+    for (i, name) in ["enc", "ax", "ay", "az"].iter().enumerate() {
+        vals[i] = parse_int(fields[i + 1], true)
+            .and_then(|v| i16::try_from(v).ok())
+            .ok_or_else(|| field_error(name, "an integer in -32768..=32767"))?;
+    }
+    // `t` was range-checked above.
+    let t = u32::try_from(t).map_err(|_| field_error("t_us", "a u32"))?;
+    Ok((t, vals[0], [vals[1], vals[2], vals[3]]))
+}
+
+fn field_error(name: &str, expected: &str) -> String {
+    format!("field `{name}` is not {expected}")
+}
+
+/// A decimal integer of at most 10 digits (enough for u32), optional `-` when `signed`.
+/// No blanks allowed: the firmware writes none, and a sign garbled into a blank would
+/// otherwise turn −12 into 12.
+fn parse_int(f: &[u8], signed: bool) -> Option<i64> {
+    let (neg, digits) = match f.strip_prefix(b"-") {
+        Some(d) if signed => (true, d),
+        _ => (false, f),
+    };
+    if digits.is_empty() || digits.len() > 10 || !digits.iter().all(u8::is_ascii_digit) {
+        return None;
+    }
+    let v = digits
+        .iter()
+        .fold(0i64, |acc, d| acc * 10 + i64::from(d - b'0'));
+    Some(if neg { -v } else { v })
+}
+
+/// Writes a serial capture as the `serial-v1` firmware does (used by the twin and by tests).
+pub struct SerialWriter<W: Write> {
+    w: W,
+}
+
+impl<W: Write> SerialWriter<W> {
+    /// Writes `# key=value` lines for every header entry, then the column line.
+    pub fn new(mut w: W, header: &Header) -> io::Result<Self> {
+        for (k, v) in &header.entries {
+            let k: String = k
+                .chars()
+                .map(|c| if c == '=' || c.is_control() { '_' } else { c })
+                .collect();
+            let v: String = v
+                .chars()
+                .map(|c| if c.is_control() { ' ' } else { c })
+                .collect();
+            writeln!(w, "# {k}={v}")?;
+        }
+        writeln!(w, "{COLUMN_LINE}")?;
+        Ok(Self { w })
+    }
+
+    pub fn write_sample(&mut self, t_us_raw: u32, enc_raw: i16, raw: [i16; 3]) -> io::Result<()> {
+        writeln!(
+            self.w,
+            "{t_us_raw},{enc_raw},{},{},{}",
+            raw[0], raw[1], raw[2]
+        )
+    }
+
+    /// Writes `s` verbatim (no line end added): for injecting damaged lines.
+    pub fn write_raw(&mut self, s: &str) -> io::Result<()> {
+        self.w.write_all(s.as_bytes())
+    }
+
+    /// Flushes and returns the inner writer.
+    pub fn finish(mut self) -> io::Result<W> {
+        self.w.flush()?;
+        Ok(self.w)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parses_rows_strictly() {
+        assert_eq!(
+            parse_row(b"3954112736,-3,41,-12,8237"),
+            Ok((3954112736, -3, [41, -12, 8237]))
+        );
+        assert!(parse_row(b"4294967296,0,0,0,0").is_err());
+        assert!(parse_row(b"1,32768,0,0,0").is_err());
+        assert!(parse_row(b"-1,0,0,0,0").is_err());
+        assert!(parse_row(b"1,0,0,0").is_err());
+        assert!(parse_row(b"1,0,0,0,0,2,0,0,0,0").is_err());
+        assert!(parse_row(b"1,0,0,x0,0").is_err());
+        assert!(parse_row(b"1,0,0,,0").is_err());
+        assert!(parse_row(b"1,-,0,0,0").is_err());
+        assert!(parse_row(b"1,0,0, 12,0").is_err());
+    }
+
+    #[test]
+    fn reads_the_spec_example() {
+        let text = "# firmware=serial-v1\n# encoder_cpr=4096\n# accel_lsb_per_g=8192\n\
+                    # sample_hz=200\n# started=2026-03-14T10:22:05Z\n# operator=ann\n\
+                    t_us,enc,ax,ay,az\n3954112736,-3,41,-12,8237\n3954117741,-3,39,-15,8240\n";
+        let mut r = SerialReader::new(text.as_bytes(), "x.csv", ReadOptions::default()).unwrap();
+        assert_eq!(r.header().get("operator"), Some("ann"));
+        assert_eq!(r.header().started(), Some("2026-03-14T10:22:05Z"));
+        let mut n = 0;
+        while let Some(s) = r.next_sample().unwrap() {
+            if let Sample::Accel(a) = s {
+                assert!((a.si_m_s2[2] - 9.81).abs() < 0.1);
+            }
+            n += 1;
+        }
+        assert_eq!(n, 4);
+        assert_eq!(r.stats().encoder_samples, 2);
+    }
+
+    #[test]
+    fn rejects_non_captures() {
+        let e = SerialReader::new(&b"hello\n"[..], "a.txt", ReadOptions::default())
+            .err()
+            .unwrap()
+            .to_string();
+        assert!(e.contains("a.txt") && e.contains("line 1"), "{e}");
+        let e = SerialReader::new(&b"# a=b\n\nfoo\n"[..], "b.txt", ReadOptions::default())
+            .err()
+            .unwrap()
+            .to_string();
+        assert!(e.contains("line 3") && e.contains(COLUMN_LINE), "{e}");
+        assert!(SerialReader::new(&b""[..], "c", ReadOptions::default()).is_err());
+        // Old captures without a header are fine.
+        assert!(
+            SerialReader::new(&b"t_us,enc,ax,ay,az\n"[..], "d", ReadOptions::default()).is_ok()
+        );
+    }
+}

@@ -1,0 +1,731 @@
+//! The rig's digital twin: simulates a campaign with the full physics of `effects.md` and the
+//! sensors and firmware of `rig.md`, and writes raw captures, `campaign.toml` and the truth.
+//!
+//! Everything is drawn from one seed (ChaCha8), so a case file always gives the same bytes.
+//!
+//! A run: the pendulum is released by hand (θ0, θ̇0) with the shaker stopped; after `free_s` the
+//! shaker starts and reaches speed with a smooth ramp over `spinup_turns` crank turns; the real
+//! crank speed is the set point times (1 + ε), |ε| ≤ `speed_error_max`. The truth's t = 0 is the
+//! first crank angle φ = 2πn (the positive acceleration peak) after the crank is at speed.
+
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::ops::ControlFlow;
+use std::path::{Path, PathBuf};
+
+use pendulum_model::{
+    classify_poincare, integrate, ClassifyOptions, CrankDrive, Effects, Excitation, Model,
+    Physical, SimOptions, SteadyState,
+};
+use rand::{Rng, RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use serde::{Deserialize, Serialize};
+
+use crate::capture::Header;
+use crate::sd::SdWriter;
+use crate::serial::SerialWriter;
+use crate::RigError;
+
+/// A twin case: the rig, the truth, the sensors and the runs (`pendulum synth CASE.toml`).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TwinCase {
+    pub name: String,
+    pub seed: u64,
+    pub rig: TwinRig,
+    pub truth: TwinTruth,
+    #[serde(default)]
+    pub sensors: SensorModel,
+    #[serde(rename = "run")]
+    pub runs: Vec<TwinRun>,
+}
+
+/// Geometry shared by the runs, SI.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TwinRig {
+    pub m_kg: f64,
+    pub l_m: f64,
+    pub crank_r_m: f64,
+    #[serde(rename = "rod_L_m")]
+    pub rod_l_m: f64,
+    pub r_b_m: f64,
+    #[serde(default = "default_g")]
+    pub g_m_s2: f64,
+}
+
+fn default_g() -> f64 {
+    pendulum_model::params::G_STANDARD_M_S2
+}
+
+/// The damping and effects the captures really hold.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TwinTruth {
+    #[serde(default)]
+    pub a_kg_m: f64,
+    pub b_n_s_m: f64,
+    pub mu: f64,
+    #[serde(default)]
+    pub effects: Effects,
+}
+
+/// Sensor and firmware imperfections (`rig.md`); defaults are the rig's typical values.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SensorModel {
+    /// Accelerometer noise density, µg/√Hz.
+    pub accel_noise_ug_rt_hz: f64,
+    /// Accelerometer internal low-pass corner, Hz (band-limits the noise; its delay is compensated).
+    pub accel_lpf_hz: f64,
+    /// Largest zero-g offset per axis, LSB (drawn per run).
+    pub accel_offset_lsb_max: f64,
+    /// Sample-time jitter (standard deviation), µs.
+    pub jitter_us: f64,
+    /// Probability that a serial line is cut, garbled or merged with the next.
+    pub serial_glitch_rate: f64,
+    /// Probability per line that a burst of 5–40 serial samples goes missing.
+    pub serial_burst_rate: f64,
+    /// Corrupted spots per MB of SD capture.
+    pub sd_corruptions_per_mb: f64,
+    /// Cut the SD capture's last frame short (a power cut).
+    pub sd_truncate_last_frame: bool,
+    /// Largest relative error of the real crank speed vs its set point.
+    pub speed_error_max: f64,
+    /// Spin-up length in crank turns.
+    pub spinup_turns: f64,
+    /// Largest encoder zeroing error, counts (the effect `encoder_offset` comes on top).
+    pub encoder_zero_counts_max: i64,
+}
+
+impl Default for SensorModel {
+    fn default() -> Self {
+        Self {
+            accel_noise_ug_rt_hz: 400.0,
+            accel_lpf_hz: 44.0,
+            accel_offset_lsb_max: 300.0,
+            jitter_us: 20.0,
+            serial_glitch_rate: 0.002,
+            serial_burst_rate: 0.0002,
+            sd_corruptions_per_mb: 4.0,
+            sd_truncate_last_frame: true,
+            speed_error_max: 0.005,
+            spinup_turns: 1.5,
+            encoder_zero_counts_max: 2,
+        }
+    }
+}
+
+impl SensorModel {
+    /// No noise, no glitches, exact speed: for tests that need the bare physics.
+    pub fn ideal() -> Self {
+        Self {
+            accel_noise_ug_rt_hz: 0.0,
+            accel_offset_lsb_max: 0.0,
+            jitter_us: 0.0,
+            serial_glitch_rate: 0.0,
+            serial_burst_rate: 0.0,
+            sd_corruptions_per_mb: 0.0,
+            sd_truncate_last_frame: false,
+            speed_error_max: 0.0,
+            encoder_zero_counts_max: 0,
+            ..Self::default()
+        }
+    }
+}
+
+/// Which firmware wrote a run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum TwinFormat {
+    /// `serial-v1` text at 200 Hz.
+    Serial,
+    /// `sd-v2` binary, encoder 1000 Hz, accelerometer 200 Hz.
+    Sd,
+}
+
+/// One run of the case.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TwinRun {
+    pub id: String,
+    pub omega_hz: f64,
+    pub role: String,
+    pub format: TwinFormat,
+    /// Release angle, rad, and rate, rad/s, at the start of the capture.
+    pub theta0_rad: f64,
+    #[serde(default)]
+    pub theta_dot0_rad_s: f64,
+    /// Free-motion time before the shaker starts, s.
+    #[serde(default = "default_free_s")]
+    pub free_s: f64,
+    /// Forced time after the shaker starts, s.
+    pub forced_s: f64,
+    /// Board clock at the first sample, µs (random when absent); near 2³² to force a wrap.
+    #[serde(default)]
+    pub clock_start_us: Option<u32>,
+    /// Crank radius for this run, m (the rig's when absent).
+    #[serde(default)]
+    pub crank_r_m: Option<f64>,
+}
+
+fn default_free_s() -> f64 {
+    4.0
+}
+
+/// What the captures really hold, for tests (the analysis never reads it).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct TwinTruthFile {
+    pub case: String,
+    pub seed: u64,
+    pub params: Physical,
+    pub runs: Vec<RunTruth>,
+}
+
+/// One run's truth.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct RunTruth {
+    pub id: String,
+    pub file: String,
+    pub format: TwinFormat,
+    pub role: String,
+    /// The real crank speed, Hz.
+    pub omega_real_hz: f64,
+    /// Shaker switched on, s since the first sample.
+    pub shaker_start_s: f64,
+    /// Aligned t = 0 (first positive acceleration peak at speed), s since the first sample.
+    pub t0_s: f64,
+    /// Board clock (unwrapped, µs, counted from the first sample's raw value) at t = 0.
+    pub t0_board_us: f64,
+    /// True θ (rad) and θ̇ (rad/s) at t = 0.
+    pub theta0_rad: f64,
+    pub theta_dot0_rad_s: f64,
+    /// The same in dimensionless time.
+    pub theta_dot0_dimless: f64,
+    pub steady: SteadyState,
+    pub accel_offset_lsb: [i16; 3],
+    pub encoder_zero_counts: i64,
+    pub clock_start_us: u32,
+    pub encoder_samples: u64,
+    pub accel_samples: u64,
+    /// Samples the firmware lost or damaged on purpose (bursts, glitches, corruption).
+    pub damaged_pieces: u64,
+}
+
+/// What `synthesize` wrote.
+#[derive(Debug, Clone)]
+pub struct TwinSummary {
+    pub dir: PathBuf,
+    pub campaign: PathBuf,
+    pub truth: PathBuf,
+    pub truth_data: TwinTruthFile,
+}
+
+impl TwinCase {
+    /// Reads a case file; errors name the file and the offending key.
+    pub fn load(path: &Path) -> Result<Self, RigError> {
+        let text = std::fs::read_to_string(path).map_err(|source| RigError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Self::from_toml(&text, path)
+    }
+
+    /// Parses case TOML (`path` only names the source in errors).
+    pub fn from_toml(text: &str, path: &Path) -> Result<Self, RigError> {
+        let case: TwinCase = toml::from_str(text).map_err(|e| {
+            let (line, column) = e.span().map(|s| line_col(text, s.start)).unwrap_or((0, 0));
+            RigError::CampaignSyntax {
+                path: path.to_path_buf(),
+                line,
+                column,
+                message: e.message().to_string(),
+            }
+        })?;
+        case.physical()
+            .validate()
+            .map_err(|e| RigError::CampaignKey {
+                path: path.to_path_buf(),
+                run: None,
+                key: "rig/truth".into(),
+                expected: e.to_string(),
+            })?;
+        Ok(case)
+    }
+
+    /// The truth as one physical parameter set (Ω per run is set in `run_physical`).
+    pub fn physical(&self) -> Physical {
+        Physical {
+            m_kg: self.rig.m_kg,
+            l_m: self.rig.l_m,
+            crank_r_m: self.rig.crank_r_m,
+            rod_l_m: self.rig.rod_l_m,
+            r_b_m: self.rig.r_b_m,
+            omega_hz: 1.0,
+            g_m_s2: self.rig.g_m_s2,
+            a_kg_m: self.truth.a_kg_m,
+            b_n_s_m: self.truth.b_n_s_m,
+            mu: self.truth.mu,
+            effects: self.truth.effects.clone(),
+        }
+    }
+}
+
+fn line_col(text: &str, offset: usize) -> (usize, usize) {
+    let before = &text[..offset.min(text.len())];
+    let line = before.matches('\n').count() + 1;
+    let col = before.len() - before.rfind('\n').map_or(0, |i| i + 1) + 1;
+    (line, col)
+}
+
+fn gauss<R: Rng>(rng: &mut R) -> f64 {
+    // Box–Muller: enough for sensor noise, and needs no extra crate.
+    let u1: f64 = rng.random::<f64>().max(1e-300);
+    let u2: f64 = rng.random::<f64>();
+    (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()
+}
+
+/// One sample instant of either sensor.
+#[derive(Clone, Copy)]
+enum Kind {
+    Encoder,
+    Accel,
+    Poincare,
+}
+
+/// Simulates every run of `case` and writes the campaign into `out_dir`.
+pub fn synthesize(case: &TwinCase, out_dir: &Path) -> Result<TwinSummary, RigError> {
+    std::fs::create_dir_all(out_dir).map_err(|source| RigError::Io {
+        path: out_dir.to_path_buf(),
+        source,
+    })?;
+    let mut truths = Vec::new();
+    for (i, run) in case.runs.iter().enumerate() {
+        let seed = case
+            .seed
+            .wrapping_mul(0x9E37_79B9_7F4A_7C15)
+            .wrapping_add(i as u64 + 1);
+        truths.push(synthesize_run(case, run, seed, out_dir)?);
+    }
+    let campaign_path = out_dir.join("campaign.toml");
+    let mut text = String::new();
+    text.push_str(&format!(
+        "# Written by the pendulum digital twin from case {:?}, seed {}.\nname = {:?}\ng_m_s2 = {}\n\n[rig]\nm_kg = {}\nl_m = {}\nrod_L_m = {}\nr_b_m = {}\n",
+        case.name, case.seed, case.name, case.rig.g_m_s2, case.rig.m_kg, case.rig.l_m, case.rig.rod_l_m, case.rig.r_b_m
+    ));
+    for (run, t) in case.runs.iter().zip(&truths) {
+        text.push_str(&format!(
+            "\n[[run]]\nid = {:?}\nfile = {:?}\ncrank_r_m = {}\nomega_hz = {}\nrole = {:?}\n",
+            run.id,
+            t.file,
+            run.crank_r_m.unwrap_or(case.rig.crank_r_m),
+            run.omega_hz,
+            run.role
+        ));
+    }
+    write_atomic(&campaign_path, text.as_bytes())?;
+    let truth = TwinTruthFile {
+        case: case.name.clone(),
+        seed: case.seed,
+        params: case.physical(),
+        runs: truths,
+    };
+    let truth_path = out_dir.join("truth.json");
+    let json = serde_json::to_vec_pretty(&truth).map_err(|e| RigError::Io {
+        path: truth_path.clone(),
+        source: std::io::Error::other(e),
+    })?;
+    write_atomic(&truth_path, &json)?;
+    Ok(TwinSummary {
+        dir: out_dir.to_path_buf(),
+        campaign: campaign_path,
+        truth: truth_path,
+        truth_data: truth,
+    })
+}
+
+fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), RigError> {
+    let tmp = path.with_extension("tmp");
+    let io = |source| RigError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    std::fs::write(&tmp, bytes).map_err(io)?;
+    std::fs::rename(&tmp, path).map_err(io)
+}
+
+fn synthesize_run(
+    case: &TwinCase,
+    run: &TwinRun,
+    seed: u64,
+    out_dir: &Path,
+) -> Result<RunTruth, RigError> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let s = &case.sensors;
+    let mut phys = case.physical();
+    phys.crank_r_m = run.crank_r_m.unwrap_or(case.rig.crank_r_m);
+    let speed_err = if s.speed_error_max > 0.0 {
+        rng.random_range(-s.speed_error_max..=s.speed_error_max)
+    } else {
+        0.0
+    };
+    phys.omega_hz = run.omega_hz * (1.0 + speed_err);
+    let bad = |expected: String| RigError::CampaignKey {
+        path: PathBuf::from(format!("{}.toml", case.name)),
+        run: Some(run.id.clone()),
+        key: "run".into(),
+        expected,
+    };
+    phys.validate().map_err(|e| bad(e.to_string()))?;
+    let d = phys.to_dimensionless();
+    let w0 = phys.omega0_rad_s();
+    // Dimensionless time of the shaker start and of being at speed.
+    let t_start = run.free_s * w0;
+    let spinup = if d.omega > 0.0 {
+        // ∫φ̇ over the ramp = ω·T/2 = turns·2π.
+        2.0 * s.spinup_turns * 2.0 * std::f64::consts::PI / d.omega
+    } else {
+        0.0
+    };
+    let phi0 = rng.random_range(0.0..2.0 * std::f64::consts::PI);
+    let drive = CrankDrive {
+        r_over_l: phys.crank_r_m / phys.l_m,
+        lambda: d.lambda,
+        tan_delta: d.tan_delta,
+        omega: d.omega,
+        phi0,
+        t_start: Some(t_start),
+        spinup,
+        omega_drift: d.omega_drift,
+    };
+    let model = Model::with_excitation(d, Excitation::Crank(drive));
+    // Aligned t = 0: the first φ = 2πn after the crank is at speed.
+    let t_speed = drive.t_at_speed();
+    let (phi_speed, _, _) = drive.phase(t_speed);
+    let two_pi = 2.0 * std::f64::consts::PI;
+    let phi_target = (phi_speed / two_pi).ceil() * two_pi;
+    let t0_dimless = {
+        // Solve φ(t) = φ_target by Newton (φ̇ ≈ ω, with drift).
+        let mut t = t_speed + (phi_target - phi_speed) / d.omega.max(1e-12);
+        for _ in 0..30 {
+            let (p, dp, _) = drive.phase(t);
+            t -= (p - phi_target) / dp.max(1e-12);
+        }
+        t
+    };
+    let duration_s = run.free_s + run.forced_s;
+    let t_end = duration_s * w0;
+    if t0_dimless >= t_end {
+        return Err(bad(format!(
+            "forced_s = {} is too short to reach speed (needs > {:.2} s)",
+            run.forced_s,
+            (t0_dimless / w0) - run.free_s
+        )));
+    }
+
+    // Sample instants (seconds from the first sample), jittered.
+    let (enc_hz, acc_hz) = match run.format {
+        TwinFormat::Serial => (200.0, 200.0),
+        TwinFormat::Sd => (1000.0, 200.0),
+    };
+    let jitter = |rng: &mut ChaCha8Rng, hz: f64| -> Vec<f64> {
+        let n = (duration_s * hz).floor() as usize;
+        let mut out = Vec::with_capacity(n);
+        let mut last = f64::NEG_INFINITY;
+        for k in 0..n {
+            let mut t = k as f64 / hz + s.jitter_us * 1e-6 * gauss(rng);
+            t = t.max(last + 1e-6).max(0.0);
+            // Whole microseconds: what the board stamps.
+            t = (t * 1e6).round() * 1e-6;
+            if t <= last {
+                t = last + 1e-6;
+            }
+            out.push(t);
+            last = t;
+        }
+        out
+    };
+    let t_acc = jitter(&mut rng, acc_hz);
+    let t_enc = match run.format {
+        TwinFormat::Serial => t_acc.clone(), // one line carries both
+        TwinFormat::Sd => jitter(&mut rng, enc_hz),
+    };
+    // Poincaré points of the truth: one per forcing period from t = 0 on.
+    let period = d.forcing_period();
+    let mut t_poin = Vec::new();
+    let mut tp = t0_dimless;
+    while tp <= t_end {
+        t_poin.push(tp);
+        tp += period;
+    }
+    let mut events: Vec<(f64, Kind, usize)> =
+        Vec::with_capacity(t_enc.len() + t_acc.len() + t_poin.len());
+    events.extend(
+        t_enc
+            .iter()
+            .enumerate()
+            .map(|(i, &t)| (t * w0, Kind::Encoder, i)),
+    );
+    if run.format == TwinFormat::Sd {
+        events.extend(
+            t_acc
+                .iter()
+                .enumerate()
+                .map(|(i, &t)| (t * w0, Kind::Accel, i)),
+        );
+    }
+    events.extend(
+        t_poin
+            .iter()
+            .enumerate()
+            .map(|(i, &t)| (t, Kind::Poincare, i)),
+    );
+    events.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut theta = vec![0.0; t_enc.len()];
+    let mut poin_th = vec![f64::NAN; t_poin.len()];
+    let mut poin_w = vec![f64::NAN; t_poin.len()];
+    let mut idx = 0usize;
+    let times: Vec<f64> = events.iter().map(|e| e.0).collect();
+    integrate(
+        &model,
+        &SimOptions::with_tol(1e-9),
+        0.0,
+        [run.theta0_rad, run.theta_dot0_rad_s / w0],
+        t_end,
+        times,
+        |smp| {
+            let (_, kind, i) = events[idx];
+            idx += 1;
+            match kind {
+                Kind::Encoder => theta[i] = smp.theta,
+                Kind::Poincare => {
+                    poin_th[i] = smp.theta;
+                    poin_w[i] = smp.theta_dot;
+                }
+                Kind::Accel => {}
+            }
+            ControlFlow::Continue(())
+        },
+    )
+    .map_err(|e| bad(format!("simulation failed: {e}")))?;
+
+    // Truth at t = 0 and the steady state of the last part of the run.
+    let theta0 = poin_th[0];
+    let theta_dot0 = poin_w[0];
+    let n = poin_th.len();
+    let rec = (n / 3).clamp(2, 40).min(n);
+    let steady = classify_poincare(
+        &poin_th[n - rec..],
+        &poin_w[n - rec..],
+        &ClassifyOptions::default(),
+    );
+
+    // Accelerometer: true specific force at (t − Δ), gain, offsets, band-limited noise, int16.
+    let lsb_per_g = 8192.0;
+    let gain = 1.0 + phys.effects.accel_gain_k_a.unwrap_or(0.0);
+    let delay_s = phys.effects.accel_delay_s.unwrap_or(0.0);
+    let off_max = s.accel_offset_lsb_max;
+    let mut offsets = [0i16; 3];
+    for o in &mut offsets {
+        *o = if off_max > 0.0 {
+            rng.random_range(-off_max..=off_max).round() as i16
+        } else {
+            0
+        };
+    }
+    // White noise at the sample rate through a one-pole low-pass at the sensor's corner, scaled
+    // so that its standard deviation is density·sqrt(π/2·f_c) (the one-pole noise bandwidth).
+    let sigma_g =
+        s.accel_noise_ug_rt_hz * 1e-6 * (std::f64::consts::FRAC_PI_2 * s.accel_lpf_hz).sqrt();
+    let a_coef = (-2.0 * std::f64::consts::PI * s.accel_lpf_hz / acc_hz).exp();
+    let white_scale = sigma_g * ((1.0 - a_coef * a_coef).max(0.0)).sqrt();
+    let mut lp = [0.0f64; 3];
+    let mut acc_raw = Vec::with_capacity(t_acc.len());
+    for &t in &t_acc {
+        let (ay, ax) = model.excitation.accel((t - delay_s) * w0);
+        let truth_g = [ax, 0.0, 1.0 + ay];
+        let mut raw = [0i16; 3];
+        for k in 0..3 {
+            lp[k] = a_coef * lp[k] + white_scale * gauss(&mut rng);
+            let v = truth_g[k] * gain * lsb_per_g + lp[k] * lsb_per_g + offsets[k] as f64;
+            raw[k] = v.round().clamp(i16::MIN as f64, i16::MAX as f64) as i16;
+        }
+        acc_raw.push(raw);
+    }
+    // Encoder: floor(4096·(θ + θ_off)/2π) + zeroing error, wrapped to i16.
+    let zero_err = if s.encoder_zero_counts_max > 0 {
+        rng.random_range(-s.encoder_zero_counts_max..=s.encoder_zero_counts_max)
+    } else {
+        0
+    };
+    let theta_off = phys.effects.encoder_offset_rad.unwrap_or(0.0);
+    let counts: Vec<i64> = theta
+        .iter()
+        .map(|&th| (4096.0 * (th + theta_off) / two_pi).floor() as i64 + zero_err)
+        .collect();
+    let clock_start = run.clock_start_us.unwrap_or_else(|| rng.random::<u32>());
+    let stamp = |t: f64| -> u32 { clock_start.wrapping_add((t * 1e6).round() as u64 as u32) };
+
+    let mut header = Header {
+        entries: vec![
+            (
+                "firmware".into(),
+                match run.format {
+                    TwinFormat::Serial => "serial-v1".into(),
+                    TwinFormat::Sd => "sd-v2".into(),
+                },
+            ),
+            ("encoder_cpr".into(), "4096".into()),
+            ("accel_lsb_per_g".into(), "8192".into()),
+        ],
+    };
+    match run.format {
+        TwinFormat::Serial => header.entries.push(("sample_hz".into(), "200".into())),
+        TwinFormat::Sd => {
+            header.entries.push(("encoder_hz".into(), "1000".into()));
+            header.entries.push(("accel_hz".into(), "200".into()));
+        }
+    }
+    header
+        .entries
+        .push(("started".into(), "2026-03-14T10:22:05Z".into()));
+    header.entries.push(("twin_seed".into(), seed.to_string()));
+
+    let mut damaged = 0u64;
+    let file_name = match run.format {
+        TwinFormat::Serial => format!("{}.csv", run.id),
+        TwinFormat::Sd => format!("{}.bin", run.id),
+    };
+    let path = out_dir.join(&file_name);
+    let file = File::create(&path).map_err(|source| RigError::Io {
+        path: path.clone(),
+        source,
+    })?;
+    let io = |source| RigError::Io {
+        path: path.clone(),
+        source,
+    };
+    match run.format {
+        TwinFormat::Serial => {
+            let mut w = SerialWriter::new(BufWriter::new(file), &header).map_err(io)?;
+            let mut k = 0;
+            while k < t_acc.len() {
+                if s.serial_burst_rate > 0.0 && rng.random::<f64>() < s.serial_burst_rate {
+                    let burst = rng.random_range(5..=40usize);
+                    k += burst;
+                    damaged += 1;
+                    continue;
+                }
+                let line = format!(
+                    "{},{},{},{},{}",
+                    stamp(t_acc[k]),
+                    counts[k] as i16,
+                    acc_raw[k][0],
+                    acc_raw[k][1],
+                    acc_raw[k][2]
+                );
+                if s.serial_glitch_rate > 0.0
+                    && rng.random::<f64>() < s.serial_glitch_rate
+                    && k + 1 < t_acc.len()
+                {
+                    damaged += 1;
+                    match rng.random_range(0..3u8) {
+                        0 => {
+                            // Cut short, before the last field: a cut inside the last number would
+                            // look like a valid line to any reader.
+                            let last_comma = line.rfind(',').unwrap_or(1).max(1);
+                            let cut = rng.random_range(1..=last_comma);
+                            w.write_raw(&format!("{}\n", &line[..cut])).map_err(io)?;
+                        }
+                        1 => {
+                            // Garbled: a few characters replaced by junk.
+                            let mut bytes = line.clone().into_bytes();
+                            for _ in 0..rng.random_range(1..4) {
+                                let p = rng.random_range(0..bytes.len());
+                                bytes[p] = b"#@!x?;:~"[rng.random_range(0..8usize)];
+                            }
+                            w.write_raw(&format!("{}\n", String::from_utf8_lossy(&bytes)))
+                                .map_err(io)?;
+                        }
+                        _ => {
+                            // Two lines run into one: this one loses its newline.
+                            let next = format!(
+                                "{},{},{},{},{}",
+                                stamp(t_acc[k + 1]),
+                                counts[k + 1] as i16,
+                                acc_raw[k + 1][0],
+                                acc_raw[k + 1][1],
+                                acc_raw[k + 1][2]
+                            );
+                            w.write_raw(&format!("{line}{next}\n")).map_err(io)?;
+                            k += 1;
+                        }
+                    }
+                } else {
+                    w.write_sample(stamp(t_acc[k]), counts[k] as i16, acc_raw[k])
+                        .map_err(io)?;
+                }
+                k += 1;
+            }
+            let mut inner = w.finish().map_err(io)?;
+            inner.flush().map_err(io)?;
+        }
+        TwinFormat::Sd => {
+            let mut buf: Vec<u8> = Vec::new();
+            {
+                let mut w = SdWriter::new(&mut buf, &header).map_err(io)?;
+                let (mut ie, mut ia) = (0, 0);
+                while ie < t_enc.len() || ia < t_acc.len() {
+                    let take_enc =
+                        ia >= t_acc.len() || (ie < t_enc.len() && t_enc[ie] <= t_acc[ia]);
+                    if take_enc {
+                        w.write_encoder(stamp(t_enc[ie]), counts[ie] as i16)
+                            .map_err(io)?;
+                        ie += 1;
+                    } else {
+                        w.write_accel(stamp(t_acc[ia]), acc_raw[ia]).map_err(io)?;
+                        ia += 1;
+                    }
+                }
+                w.finish().map_err(io)?;
+            }
+            // A bad card sector: flip bytes at a few random spots past the header.
+            let spots = (s.sd_corruptions_per_mb * buf.len() as f64 / 1e6).round() as usize;
+            for _ in 0..spots {
+                let p = rng.random_range(64..buf.len().max(65));
+                if p < buf.len() {
+                    buf[p] ^= 1 << rng.random_range(0..8u32);
+                    damaged += 1;
+                }
+            }
+            if s.sd_truncate_last_frame && buf.len() > 64 {
+                let cut = rng.random_range(1..8usize);
+                buf.truncate(buf.len() - cut);
+                damaged += 1;
+            }
+            let mut f = BufWriter::new(file);
+            f.write_all(&buf).map_err(io)?;
+            f.flush().map_err(io)?;
+        }
+    }
+    Ok(RunTruth {
+        id: run.id.clone(),
+        file: file_name,
+        format: run.format,
+        role: run.role.clone(),
+        omega_real_hz: phys.omega_hz,
+        shaker_start_s: run.free_s,
+        t0_s: t0_dimless / w0,
+        t0_board_us: t0_dimless / w0 * 1e6,
+        theta0_rad: theta0,
+        theta_dot0_rad_s: theta_dot0 * w0,
+        theta_dot0_dimless: theta_dot0,
+        steady,
+        accel_offset_lsb: offsets,
+        encoder_zero_counts: zero_err,
+        clock_start_us: clock_start,
+        encoder_samples: t_enc.len() as u64,
+        accel_samples: t_acc.len() as u64,
+        damaged_pieces: damaged,
+    })
+}
