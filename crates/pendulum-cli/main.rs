@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use pendulum_jobs::{demo, ingest, simulate, synth};
+use pendulum_jobs::{demo, identify, ingest, simulate, synth};
 use pendulum_model::SteadyClass;
 
 #[derive(Parser)]
@@ -30,6 +30,11 @@ enum Command {
     Ingest(IngestArgs),
     /// Simulate a campaign with the rig's digital twin: raw captures, campaign.toml, truth.json.
     Synth(SynthArgs),
+    /// Identify damping by the study's method (align, initial conditions, DE fit, validation);
+    /// writes params/initial_conditions/residuals/convergence/runs Parquet tables and plots.
+    Identify(IdentifyArgs),
+    /// Validate given damping parameters (from a params.parquet) on a campaign's validate runs.
+    Validate(ValidateArgs),
 }
 
 #[derive(clap::Args)]
@@ -42,6 +47,66 @@ struct IngestArgs {
     /// No progress bar.
     #[arg(long)]
     quiet: bool,
+}
+
+#[derive(clap::Args)]
+struct IdentifyArgs {
+    /// A campaign folder (raw captures + campaign.toml) or a folder of .mcap run logs.
+    input: PathBuf,
+    /// Output folder for the tables and plots.
+    #[arg(long)]
+    out: PathBuf,
+    /// Damping model: reference (a, b, μ) or linear (b only).
+    #[arg(long)]
+    model: Option<String>,
+    /// Pipeline file (default: the built-in pipelines/identify.toml).
+    #[arg(long)]
+    pipeline: Option<PathBuf>,
+    /// DE population size (default 10·(3 + 2N)).
+    #[arg(long)]
+    np: Option<usize>,
+    /// Generation cap.
+    #[arg(long)]
+    generations: Option<u64>,
+    /// Stop when best − worst < tol; `--tol 0 --generations G` runs exactly G generations.
+    #[arg(long)]
+    tol: Option<f64>,
+    /// Read --tol relative to the best objective (scale-free) instead of absolute.
+    #[arg(long)]
+    relative_tol: bool,
+    /// Random seed.
+    #[arg(long)]
+    seed: Option<u64>,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Fit window after t = 0, s.
+    #[arg(long)]
+    window_s: Option<f64>,
+    /// Evaluate every trial in full (the plain algorithm; same result, slower).
+    #[arg(long)]
+    no_early_abandon: bool,
+    /// No progress bar.
+    #[arg(long)]
+    quiet: bool,
+}
+
+#[derive(clap::Args)]
+struct ValidateArgs {
+    /// A campaign folder or a folder of .mcap run logs.
+    input: PathBuf,
+    /// params.parquet written by `pendulum identify`.
+    #[arg(long)]
+    params: PathBuf,
+    /// Which model row of params.parquet (default: the first).
+    #[arg(long)]
+    model: Option<String>,
+    /// Output folder.
+    #[arg(long)]
+    out: PathBuf,
+    /// Pipeline file (default: the built-in pipelines/validate.toml).
+    #[arg(long)]
+    pipeline: Option<PathBuf>,
 }
 
 #[derive(clap::Args)]
@@ -144,6 +209,36 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                     r.id, format!("{:?}", r.format).to_lowercase(), r.omega_real_hz, r.t0_s, r.theta0_rad, r.theta_dot0_rad_s, r.steady
                 );
             }
+        }
+        Command::Identify(a) => {
+            let s = identify::run(&identify::IdentifyJob {
+                input: a.input,
+                out: a.out,
+                pipeline: a.pipeline,
+                overrides: identify::FitOverrides {
+                    model: a.model,
+                    np: a.np,
+                    generations: a.generations,
+                    tol: a.tol,
+                    relative_tol: a.relative_tol,
+                    seed: a.seed,
+                    threads: a.threads,
+                    window_s: a.window_s,
+                    no_early_abandon: a.no_early_abandon,
+                },
+                progress: !a.quiet,
+            })?;
+            print!("{s}");
+        }
+        Command::Validate(a) => {
+            let s = identify::validate(&identify::ValidateJob {
+                input: a.input,
+                params: a.params,
+                model: a.model,
+                out: a.out,
+                pipeline: a.pipeline,
+            })?;
+            print!("{s}");
         }
         Command::Demo(a) => {
             println!(

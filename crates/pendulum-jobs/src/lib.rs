@@ -3,7 +3,9 @@
 //! of results (progress bars excepted).
 
 pub mod demo;
+pub mod identify;
 pub mod ingest;
+pub mod outputs;
 pub mod runs;
 pub mod simulate;
 pub mod synth;

@@ -1,0 +1,187 @@
+//! `pendulum identify` and `pendulum validate`: runs a pipeline over a campaign (raw or MCAP) and
+//! writes Parquet tables and plots into one folder per invocation.
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::time::Instant;
+
+use indicatif::{ProgressBar, ProgressStyle};
+use pendulum_fit::StopRule;
+use pendulum_process::identify::{residual_series, FitOutcome, ResidualSeries, RunFit};
+use pendulum_process::pipeline::{Context, PipelineConfig, StageConfig};
+use pendulum_process::{Role, RunData};
+
+use crate::outputs::{write_outputs, OutputSummary};
+use crate::runs::load_runs;
+use crate::JobError;
+
+/// The built-in pipelines (the same text as `pipelines/*.toml`).
+pub const IDENTIFY_PIPELINE: &str = include_str!("../../../pipelines/identify.toml");
+pub const VALIDATE_PIPELINE: &str = include_str!("../../../pipelines/validate.toml");
+
+/// Command-line overrides of the fit stage.
+#[derive(Debug, Clone, Default)]
+pub struct FitOverrides {
+    pub model: Option<String>,
+    pub np: Option<usize>,
+    pub generations: Option<u64>,
+    pub tol: Option<f64>,
+    pub relative_tol: bool,
+    pub seed: Option<u64>,
+    pub threads: Option<usize>,
+    pub window_s: Option<f64>,
+    pub no_early_abandon: bool,
+}
+
+/// What to identify.
+#[derive(Debug, Clone)]
+pub struct IdentifyJob {
+    pub input: PathBuf,
+    pub out: PathBuf,
+    pub pipeline: Option<PathBuf>,
+    pub overrides: FitOverrides,
+    pub progress: bool,
+}
+
+/// Loads a pipeline file or the built-in one.
+pub fn load_pipeline(path: Option<&Path>, builtin: &str, name: &str) -> Result<(PipelineConfig, String), JobError> {
+    match path {
+        Some(p) => {
+            let text = std::fs::read_to_string(p).map_err(|source| JobError::Io {
+                path: p.to_path_buf(),
+                source,
+            })?;
+            Ok((PipelineConfig::from_toml(&text, p)?, text))
+        }
+        None => Ok((
+            PipelineConfig::from_toml(builtin, Path::new(&format!("<built-in {name}>")))?,
+            builtin.to_string(),
+        )),
+    }
+}
+
+fn apply_overrides(p: &mut PipelineConfig, o: &FitOverrides) {
+    if let Some(fit) = p.fit_mut() {
+        if let Some(m) = &o.model {
+            fit.model = m.clone();
+        }
+        if let Some(v) = o.np {
+            fit.np = Some(v);
+        }
+        if let Some(v) = o.generations {
+            fit.max_generations = v;
+        }
+        if let Some(v) = o.tol {
+            fit.tol = v;
+        }
+        if o.relative_tol {
+            fit.stop_rule = StopRule::Relative;
+        }
+        if let Some(v) = o.seed {
+            fit.seed = v;
+        }
+        if o.threads.is_some() {
+            fit.threads = o.threads;
+        }
+        if let Some(w) = o.window_s {
+            fit.window.window_s = w;
+        }
+        if o.no_early_abandon {
+            fit.early_abandon = false;
+        }
+    }
+    if let Some(w) = o.window_s {
+        for s in &mut p.stages {
+            if let StageConfig::Validate(v) = s {
+                v.window.window_s = w;
+            }
+        }
+    }
+}
+
+/// A progress bar over DE generations showing the current best.
+pub fn generation_bar(max_generations: u64) -> (ProgressBar, pendulum_process::identify::ProgressFn) {
+    let bar = ProgressBar::new(max_generations);
+    bar.set_style(
+        ProgressStyle::with_template("{prefix:>18} {bar:30} gen {pos}/{len} {msg} [{elapsed_precise}]")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    let b = bar.clone();
+    let f: pendulum_process::identify::ProgressFn = Arc::new(move |label: &str, g| {
+        b.set_prefix(label.to_string());
+        b.set_position(g.generation);
+        b.set_message(format!("best {:.4} worst {:.4}", g.best, g.worst));
+    });
+    (bar, f)
+}
+
+/// Residual histories of every fitted model on every run it saw (identify runs from the fit,
+/// validate runs from the validation).
+pub fn residuals_of(ctx: &Context, fit: &FitOutcome, validation: Option<&[RunFit]>, span_s: f64) -> Result<Vec<(String, Role, ResidualSeries)>, JobError> {
+    let window = pendulum_process::identify::Window::default();
+    let mut out = Vec::new();
+    let mut all: Vec<&RunFit> = fit.runs.iter().collect();
+    if let Some(v) = validation {
+        all.extend(v.iter());
+    }
+    for rf in all {
+        let Some(run) = ctx.runs.iter().find(|r| r.id == rf.id) else { continue };
+        let Some(al) = ctx.alignments.get(&rf.id) else { continue };
+        let series = residual_series(run, al, &fit.spec, &fit.params, rf.ic_fit, &window, span_s)?;
+        out.push((rf.id.clone(), rf.role, series));
+    }
+    Ok(out)
+}
+
+/// Runs the identify pipeline and writes the outputs.
+pub fn run(job: &IdentifyJob) -> Result<OutputSummary, JobError> {
+    let started = Instant::now();
+    let (mut pipeline, _) = load_pipeline(job.pipeline.as_deref(), IDENTIFY_PIPELINE, "identify")?;
+    apply_overrides(&mut pipeline, &job.overrides);
+    let pipeline_text = serde_json::to_string(&pipeline).unwrap_or_default();
+    let runs: Vec<RunData> = load_runs(&job.input)?;
+    if !runs.iter().any(|r| r.role == Role::Identify) {
+        return Err(JobError::Invalid(format!("{}: no run has role = \"identify\"", job.input.display())));
+    }
+    let mut ctx = Context::new(runs);
+    let max_gen = pipeline.fit_mut().map_or(0, |f| f.max_generations);
+    let bar = if job.progress {
+        let (bar, f) = generation_bar(max_gen);
+        ctx.progress = Some(f);
+        Some(bar)
+    } else {
+        None
+    };
+    let res = pipeline.run(&mut ctx);
+    if let Some(b) = bar {
+        b.finish_and_clear();
+    }
+    res?;
+    write_outputs(&ctx, &job.out, &pipeline_text, "pendulum identify", started.elapsed().as_secs_f64())
+}
+
+/// What to validate: fixed parameters from a params.parquet.
+#[derive(Debug, Clone)]
+pub struct ValidateJob {
+    pub input: PathBuf,
+    pub params: PathBuf,
+    pub model: Option<String>,
+    pub out: PathBuf,
+    pub pipeline: Option<PathBuf>,
+}
+
+/// Runs the validate pipeline with a given model.
+pub fn validate(job: &ValidateJob) -> Result<OutputSummary, JobError> {
+    let started = Instant::now();
+    let (pipeline, _) = load_pipeline(job.pipeline.as_deref(), VALIDATE_PIPELINE, "validate")?;
+    let pipeline_text = serde_json::to_string(&pipeline).unwrap_or_default();
+    let given = crate::outputs::read_params(&job.params, job.model.as_deref())?;
+    let runs = load_runs(&job.input)?;
+    if !runs.iter().any(|r| r.role == Role::Validate) {
+        return Err(JobError::Invalid(format!("{}: no run has role = \"validate\"", job.input.display())));
+    }
+    let mut ctx = Context::new(runs);
+    ctx.given = Some(given);
+    pipeline.run(&mut ctx)?;
+    write_outputs(&ctx, &job.out, &pipeline_text, "pendulum validate", started.elapsed().as_secs_f64())
+}

@@ -1,0 +1,507 @@
+//! The Parquet tables and plots of `identify` / `validate` (and the parts `discover` shares).
+//!
+//! Tables (zstd, one folder per invocation, units in field metadata, the pipeline definition and
+//! versions in the key-value metadata): `params.parquet`, `initial_conditions.parquet`,
+//! `residuals.parquet`, `convergence.parquet`, `runs.parquet`, `validation.parquet`.
+
+use std::collections::BTreeSet;
+use std::fmt::Write as _;
+use std::fs::File;
+use std::path::{Path, PathBuf};
+
+use arrow_array::{Array, Float64Array, Int64Array, StringArray};
+use parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
+use pendulum_model::Effects;
+use pendulum_plot::{Figure, Panel, Series, SeriesStyle};
+use pendulum_process::fit::{FitParam, ModelSpec};
+use pendulum_process::identify::{FitOutcome, RunFit};
+use pendulum_process::pipeline::Context;
+use pendulum_process::Role;
+use pendulum_report::{Column, ColumnData, TableOptions};
+
+use crate::identify::residuals_of;
+use crate::JobError;
+
+/// What was written, and a printable summary.
+#[derive(Debug, Clone)]
+pub struct OutputSummary {
+    pub out_dir: PathBuf,
+    pub tables: Vec<PathBuf>,
+    pub plots: Vec<PathBuf>,
+    pub text: String,
+}
+
+impl std::fmt::Display for OutputSummary {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.text)
+    }
+}
+
+const ALL_EFFECT_PARAMS: [FitParam; 6] = [
+    FitParam::CoulombConstant,
+    FitParam::ExtraInertia,
+    FitParam::HorizontalBase,
+    FitParam::PositionTorque,
+    FitParam::PositionTorquePhase,
+    FitParam::EncoderOffset,
+];
+
+fn meta(pipeline: &str, command: &str) -> TableOptions {
+    TableOptions::new()
+        .meta("command", command)
+        .meta("pipeline", pipeline)
+        .meta("pendulum_version", env!("CARGO_PKG_VERSION"))
+}
+
+fn f64s(name: &str, unit: &str, v: Vec<f64>) -> Column {
+    Column::f64(name, unit, v)
+}
+
+fn strs(name: &str, v: Vec<String>) -> Column {
+    Column::new(name, ColumnData::Str(v))
+}
+
+fn ints(name: &str, v: Vec<i64>) -> Column {
+    Column::new(name, ColumnData::I64(v))
+}
+
+/// Rows of params.parquet: one per fitted (or given) model, dimensionless values for the first
+/// identify run's rig and crank speed.
+pub fn params_columns(ctx: &Context, fits: &[FitOutcome]) -> Vec<Column> {
+    let first = ctx
+        .runs
+        .iter()
+        .find(|r| r.role == Role::Identify)
+        .or(ctx.runs.first());
+    let mut model = Vec::new();
+    let mut cols: Vec<(String, String, Vec<f64>)> = Vec::new();
+    let mut push = |name: &str, unit: &str, v: f64, row: usize| {
+        if let Some(c) = cols.iter_mut().find(|c| c.0 == name) {
+            c.2.push(v);
+        } else {
+            let mut vals = vec![f64::NAN; row];
+            vals.push(v);
+            cols.push((name.to_string(), unit.to_string(), vals));
+        }
+    };
+    for (row, fit) in fits.iter().enumerate() {
+        model.push(fit.spec.name.clone());
+        let (rig, omega_hz) = match first {
+            Some(r) => (
+                r.rig.clone(),
+                ctx.alignments.get(&r.id).map_or(r.rig.omega_hz.unwrap_or(0.0), |a| a.omega_hz),
+            ),
+            None => continue,
+        };
+        let phys = fit.spec.physical(&rig, omega_hz, &fit.params);
+        let d = phys.to_dimensionless();
+        push("a", "kg/m", phys.a_kg_m, row);
+        push("b", "N·s/m", phys.b_n_s_m, row);
+        push("mu", "1", phys.mu, row);
+        push("alpha", "1", d.alpha, row);
+        push("beta", "1", d.beta, row);
+        push("M", "1", d.m_coulomb, row);
+        push("R", "1", d.r, row);
+        push("lambda", "1", d.lambda, row);
+        push("omega", "1", d.omega, row);
+        push("m_kg", "kg", rig.m_kg, row);
+        push("l_m", "m", rig.l_m, row);
+        push("crank_r_m", "m", rig.crank_r_m, row);
+        push("rod_L_m", "m", rig.rod_l_m, row);
+        push("r_b_m", "m", rig.r_b_m, row);
+        push("g_m_s2", "m/s²", rig.g_m_s2, row);
+        push("omega_hz", "Hz", omega_hz, row);
+        for p in ALL_EFFECT_PARAMS {
+            let v = if fit.spec.params.contains(&p) { fit.param(p) } else { f64::NAN };
+            push(p.name(), p.unit(), v, row);
+        }
+        push("f_obj", "rad", fit.f_obj, row);
+        push("e_theta", "rad", fit.e_theta, row);
+        push("n_runs", "1", fit.runs.len() as f64, row);
+        push("generations", "1", fit.generations as f64, row);
+        push("evaluations", "1", fit.evaluations as f64, row);
+        push("abandoned", "1", fit.abandoned as f64, row);
+        push("wall_s", "s", fit.wall_s, row);
+        push("seed", "1", fit.seed as f64, row);
+        push("np", "1", fit.np as f64, row);
+        push("polished_f_obj", "rad", fit.polished.as_ref().map_or(f64::NAN, |p| p.1), row);
+    }
+    let mut out = vec![strs("model", model)];
+    for (name, unit, vals) in cols {
+        let col = match name.as_str() {
+            "n_runs" | "generations" | "evaluations" | "abandoned" | "seed" | "np" => {
+                ints(&name, vals.iter().map(|v| *v as i64).collect())
+            }
+            _ => f64s(&name, &unit, vals),
+        };
+        out.push(col);
+    }
+    out
+}
+
+/// Reads one model back from a params.parquet (the first row, or the row named `model`).
+pub fn read_params(path: &Path, model: Option<&str>) -> Result<FitOutcome, JobError> {
+    let bad = |m: String| JobError::Invalid(format!("{}: {m}", path.display()));
+    let file = File::open(path).map_err(|source| JobError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let reader = ParquetRecordBatchReaderBuilder::try_new(file)
+        .map_err(|e| bad(format!("not a Parquet file: {e}")))?
+        .build()
+        .map_err(|e| bad(e.to_string()))?;
+    for batch in reader {
+        let batch = batch.map_err(|e| bad(e.to_string()))?;
+        let names = batch
+            .column_by_name("model")
+            .and_then(|c| c.as_any().downcast_ref::<StringArray>().cloned())
+            .ok_or_else(|| bad("no Utf8 column `model`: expected a params.parquet written by pendulum identify".into()))?;
+        for row in 0..batch.num_rows() {
+            let name = names.value(row).to_string();
+            if model.is_some_and(|m| m != name) {
+                continue;
+            }
+            let get = |col: &str| -> Option<f64> {
+                let c = batch.column_by_name(col)?;
+                if let Some(a) = c.as_any().downcast_ref::<Float64Array>() {
+                    return (!a.is_null(row)).then(|| a.value(row));
+                }
+                c.as_any().downcast_ref::<Int64Array>().map(|a| a.value(row) as f64)
+            };
+            let base = if name.starts_with("linear") { ModelSpec::linear() } else { ModelSpec::reference() };
+            let mut spec = ModelSpec {
+                name: name.clone(),
+                params: base.params.clone(),
+                fixed: Effects::default(),
+            };
+            for p in ALL_EFFECT_PARAMS {
+                if get(p.name()).is_some_and(|v| !v.is_nan()) {
+                    spec.params.push(p);
+                }
+            }
+            let params = spec
+                .params
+                .iter()
+                .map(|p| get(p.name()).ok_or_else(|| bad(format!("model {name}: no column {}", p.name()))))
+                .collect::<Result<Vec<f64>, _>>()?;
+            return Ok(FitOutcome {
+                spec,
+                params,
+                f_obj: get("f_obj").unwrap_or(f64::NAN),
+                e_theta: get("e_theta").unwrap_or(f64::NAN),
+                generations: get("generations").unwrap_or(0.0) as u64,
+                evaluations: get("evaluations").unwrap_or(0.0) as u64,
+                abandoned: 0,
+                stop_reason: "given".into(),
+                wall_s: 0.0,
+                seed: get("seed").unwrap_or(0.0) as u64,
+                np: get("np").unwrap_or(0.0) as usize,
+                convergence: Vec::new(),
+                runs: Vec::new(),
+                polished: None,
+            });
+        }
+    }
+    Err(bad(match model {
+        Some(m) => format!("no model named {m:?}"),
+        None => "no rows".into(),
+    }))
+}
+
+fn validation_of<'a>(ctx: &'a Context, model: &str) -> Option<&'a [RunFit]> {
+    ctx.validations.iter().find(|(m, _)| m == model).map(|(_, v)| v.as_slice())
+}
+
+/// Every fitted or given model in the context.
+pub fn models_of(ctx: &Context) -> Vec<FitOutcome> {
+    if ctx.fits.is_empty() {
+        ctx.given.clone().into_iter().collect()
+    } else {
+        ctx.fits.clone()
+    }
+}
+
+/// Writes every table and plot for the context's results into `out`.
+pub fn write_outputs(
+    ctx: &Context,
+    out: &Path,
+    pipeline: &str,
+    command: &str,
+    wall_s: f64,
+) -> Result<OutputSummary, JobError> {
+    std::fs::create_dir_all(out).map_err(|source| JobError::Io {
+        path: out.to_path_buf(),
+        source,
+    })?;
+    let opts = meta(pipeline, command);
+    let mut tables = Vec::new();
+    let mut plots = Vec::new();
+    let models = models_of(ctx);
+    let mut text = String::new();
+
+    // params.parquet
+    if !models.is_empty() {
+        let p = out.join("params.parquet");
+        opts.write(&p, &params_columns(ctx, &models))?;
+        tables.push(p);
+    }
+
+    // runs.parquet
+    {
+        let first = models.first();
+        let fitted: Vec<&RunFit> = first
+            .map(|m| m.runs.iter().chain(validation_of(ctx, &m.spec.name).unwrap_or(&[])).collect())
+            .unwrap_or_default();
+        let mut c: Vec<Vec<f64>> = vec![Vec::new(); 14];
+        let (mut ids, mut roles, mut meas, mut sim, mut agree) = (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        let mut meas_p = Vec::new();
+        let mut sim_p = Vec::new();
+        for r in &ctx.runs {
+            ids.push(r.id.clone());
+            roles.push(r.role.as_str().to_string());
+            let al = ctx.alignments.get(&r.id);
+            let ic = ctx.initial.get(&r.id);
+            let vals = [
+                r.rig.omega_hz.unwrap_or(f64::NAN),
+                al.map_or(f64::NAN, |a| a.omega_hz),
+                al.map_or(f64::NAN, |a| a.omega_sigma_hz),
+                al.map_or(f64::NAN, |a| a.shaker_start_s),
+                al.map_or(f64::NAN, |a| a.t0_s),
+                al.map_or(f64::NAN, |a| a.t0_sigma_s),
+                al.map_or(f64::NAN, |a| a.accel_gain),
+                al.map_or(f64::NAN, |a| a.residual_rms_m_s2),
+                al.map_or(f64::NAN, |a| a.free_segment_s.0),
+                al.map_or(f64::NAN, |a| a.free_segment_s.1),
+                ic.map_or(f64::NAN, |i| i.theta_rad),
+                ic.map_or(f64::NAN, |i| i.theta_dot_rad_s),
+                ctx.hanging.get(&r.id).copied().flatten().unwrap_or(f64::NAN),
+                fitted.iter().find(|f| f.id == r.id).map_or(f64::NAN, |f| f.e_theta),
+            ];
+            for (col, v) in c.iter_mut().zip(vals) {
+                col.push(v);
+            }
+            let m = ctx.steady.get(&r.id);
+            meas.push(m.map_or("-".to_string(), |s| s.class.as_str().to_string()));
+            meas_p.push(m.map_or(0, |s| s.period as i64));
+            let f = fitted.iter().find(|f| f.id == r.id);
+            let s = f.and_then(|f| f.simulated);
+            sim.push(s.map_or("-".to_string(), |s| s.class.as_str().to_string()));
+            sim_p.push(s.map_or(0, |s| s.period as i64));
+            agree.push(f.is_some_and(|f| f.steady_agrees()));
+        }
+        let names = [
+            ("omega_set_hz", "Hz"),
+            ("omega_hz", "Hz"),
+            ("omega_sigma_hz", "Hz"),
+            ("shaker_start_s", "s"),
+            ("t0_s", "s"),
+            ("t0_sigma_s", "s"),
+            ("accel_gain", "1"),
+            ("align_residual_rms_m_s2", "m/s²"),
+            ("free_start_s", "s"),
+            ("free_end_s", "s"),
+            ("theta0_est", "rad"),
+            ("theta_dot0_est", "rad/s"),
+            ("hanging_theta", "rad"),
+            ("e_theta", "rad"),
+        ];
+        let mut cols = vec![strs("run_id", ids), strs("role", roles)];
+        for ((n, u), v) in names.iter().zip(c) {
+            cols.push(f64s(n, u, v));
+        }
+        cols.push(strs("measured_steady", meas));
+        cols.push(ints("measured_period", meas_p));
+        cols.push(strs("simulated_steady", sim));
+        cols.push(ints("simulated_period", sim_p));
+        cols.push(Column::new("steady_agrees", ColumnData::Bool(agree)));
+        let p = out.join("runs.parquet");
+        opts.clone()
+            .meta("simulated_model", first.map_or("-".to_string(), |m| m.spec.name.clone()))
+            .write(&p, &cols)?;
+        tables.push(p);
+    }
+
+    // initial_conditions, convergence, residuals
+    let (mut ic_run, mut ic_model, mut ic_role) = (Vec::new(), Vec::new(), Vec::new());
+    let mut icv: Vec<Vec<f64>> = vec![Vec::new(); 4];
+    let (mut cv_model, mut cv_gen) = (Vec::new(), Vec::new());
+    let mut cvv: Vec<Vec<f64>> = vec![Vec::new(); 3];
+    let (mut rs_run, mut rs_model, mut rs_role) = (Vec::new(), Vec::new(), Vec::new());
+    let mut rsv: Vec<Vec<f64>> = vec![Vec::new(); 7];
+    for m in &models {
+        let val = validation_of(ctx, &m.spec.name);
+        for rf in m.runs.iter().chain(val.unwrap_or(&[])) {
+            let w0 = ctx.runs.iter().find(|r| r.id == rf.id).map_or(1.0, |r| r.rig.omega0_rad_s());
+            ic_run.push(rf.id.clone());
+            ic_model.push(m.spec.name.clone());
+            ic_role.push(rf.role.as_str().to_string());
+            for (col, v) in icv.iter_mut().zip([rf.ic_est[0], rf.ic_est[1] * w0, rf.ic_fit[0], rf.ic_fit[1] * w0]) {
+                col.push(v);
+            }
+        }
+        for &(g, b, w, mean) in &m.convergence {
+            cv_model.push(m.spec.name.clone());
+            cv_gen.push(g as i64);
+            cvv[0].push(b);
+            cvv[1].push(w);
+            cvv[2].push(mean);
+        }
+        for (id, role, s) in residuals_of(ctx, m, val, 60.0)? {
+            for k in 0..s.t.len() {
+                rs_run.push(id.clone());
+                rs_model.push(m.spec.name.clone());
+                rs_role.push(role.as_str().to_string());
+                let v = [s.t[k], s.tau_s[k], s.theta_meas[k], s.theta_sim[k], s.theta_meas[k] - s.theta_sim[k], s.theta_dot_meas[k], s.theta_dot_sim[k]];
+                for (col, x) in rsv.iter_mut().zip(v) {
+                    col.push(x);
+                }
+            }
+            let png = out.join(format!("history_{}_{}.png", m.spec.name.replace('+', "_"), id));
+            history_plot(&png, &id, &m.spec.name, role, &s)?;
+            plots.push(png);
+        }
+        if m.convergence.len() > 1 {
+            let png = out.join(format!("convergence_{}.png", m.spec.name.replace('+', "_")));
+            convergence_plot(&png, m)?;
+            plots.push(png);
+        }
+    }
+    if !ic_run.is_empty() {
+        let p = out.join("initial_conditions.parquet");
+        let mut cols = vec![strs("run_id", ic_run), strs("model", ic_model), strs("role", ic_role)];
+        for ((n, u), v) in [("theta0_est", "rad"), ("theta_dot0_est", "rad/s"), ("theta0_fit", "rad"), ("theta_dot0_fit", "rad/s")].iter().zip(icv) {
+            cols.push(f64s(n, u, v));
+        }
+        opts.write(&p, &cols)?;
+        tables.push(p);
+    }
+    if !cv_gen.is_empty() {
+        let p = out.join("convergence.parquet");
+        let mut cols = vec![strs("model", cv_model), ints("generation", cv_gen)];
+        for (n, v) in ["best", "worst", "mean"].iter().zip(cvv) {
+            cols.push(f64s(n, "rad", v));
+        }
+        opts.write(&p, &cols)?;
+        tables.push(p);
+    }
+    if !rs_run.is_empty() {
+        let p = out.join("residuals.parquet");
+        let mut cols = vec![strs("run_id", rs_run), strs("model", rs_model), strs("role", rs_role)];
+        let names = [
+            ("t", "1 (t = ω0·τ)"),
+            ("tau_s", "s"),
+            ("theta_meas", "rad"),
+            ("theta_sim", "rad"),
+            ("residual", "rad"),
+            ("theta_dot_meas", "rad/s"),
+            ("theta_dot_sim", "rad/s"),
+        ];
+        for ((n, u), v) in names.iter().zip(rsv) {
+            cols.push(f64s(n, u, v));
+        }
+        opts.write(&p, &cols)?;
+        tables.push(p);
+    }
+
+    // Printed summary.
+    let _ = writeln!(text, "{} runs; outputs in {} ({wall_s:.1} s)", ctx.runs.len(), out.display());
+    for m in &models {
+        let _ = write!(text, "model {:<28}", m.spec.name);
+        for (p, v) in m.spec.params.iter().zip(&m.params) {
+            let _ = write!(text, " {}={:.5}", p.name(), v);
+        }
+        let _ = writeln!(
+            text,
+            "  f_obj={:.4} E_θ={:.4} gens={} evals={} ({} abandoned) {:.1} s, stop: {}",
+            m.f_obj, m.e_theta, m.generations, m.evaluations, m.abandoned, m.wall_s, m.stop_reason
+        );
+        if let Some((x, f, n)) = &m.polished {
+            let _ = writeln!(text, "  polished: {:?} f_obj={f:.4} ({n} evals)", x);
+        }
+        for rf in m.runs.iter().chain(validation_of(ctx, &m.spec.name).unwrap_or(&[])) {
+            let _ = writeln!(
+                text,
+                "  {:<8} {:<8} E_θ={:>9.4}  measured {:<22} simulated {:<22} {}",
+                rf.id,
+                rf.role.as_str(),
+                rf.e_theta,
+                rf.measured.to_string(),
+                rf.simulated.map_or("-".into(), |s| s.to_string()),
+                if rf.steady_agrees() { "agree" } else { "DIFFER" }
+            );
+        }
+    }
+    for n in &ctx.notes {
+        let _ = writeln!(text, "note: {n}");
+    }
+    let _ = BTreeSet::<String>::new();
+    Ok(OutputSummary {
+        out_dir: out.to_path_buf(),
+        tables,
+        plots,
+        text,
+    })
+}
+
+fn history_plot(path: &Path, id: &str, model: &str, role: Role, s: &pendulum_process::identify::ResidualSeries) -> Result<(), JobError> {
+    let series = |label: &str, y: &[f64], color: usize| Series {
+        label: label.into(),
+        x: s.tau_s.clone(),
+        y: y.to_vec(),
+        style: SeriesStyle::Line,
+        color: Some(color),
+    };
+    let fig = Figure {
+        title: format!("Run {id} ({}) — measured vs {model} model", role.as_str()),
+        panels: vec![
+            Panel {
+                title: "Angle".into(),
+                x_label: "time from the first at-speed peak (s)".into(),
+                y_label: "θ (rad)".into(),
+                series: vec![series("measured", &s.theta_meas, 0), series("simulated", &s.theta_sim, 1)],
+                ..Panel::default()
+            },
+            Panel {
+                title: "Angular velocity".into(),
+                x_label: "time from the first at-speed peak (s)".into(),
+                y_label: "dθ/dt (rad/s)".into(),
+                series: vec![series("measured", &s.theta_dot_meas, 0), series("simulated", &s.theta_dot_sim, 1)],
+                ..Panel::default()
+            },
+        ],
+        width: 1200,
+        height: 800,
+    };
+    fig.save_png(path)?;
+    Ok(())
+}
+
+fn convergence_plot(path: &Path, m: &FitOutcome) -> Result<(), JobError> {
+    let x: Vec<f64> = m.convergence.iter().map(|c| c.0 as f64).collect();
+    let mk = |label: &str, y: Vec<f64>, color: usize| Series {
+        label: label.into(),
+        x: x.clone(),
+        y,
+        style: SeriesStyle::Line,
+        color: Some(color),
+    };
+    let fig = Figure {
+        title: format!("Differential Evolution convergence — {} model", m.spec.name),
+        panels: vec![Panel {
+            title: format!("Np = {}, seed {}, stop: {}", m.np, m.seed, m.stop_reason),
+            x_label: "generation".into(),
+            y_label: "objective f (rad)".into(),
+            series: vec![
+                mk("best", m.convergence.iter().map(|c| c.1).collect(), 0),
+                mk("mean", m.convergence.iter().map(|c| c.3).collect(), 2),
+                mk("worst", m.convergence.iter().map(|c| c.2).collect(), 1),
+            ],
+            log_y: true,
+            ..Panel::default()
+        }],
+        width: 1200,
+        height: 600,
+    };
+    fig.save_png(path)?;
+    Ok(())
+}
