@@ -1,4 +1,7 @@
 //! The integration test binary: one module per area (ripgrep-style). Unit tests live inline.
 
 mod cli;
+mod identify;
+mod ingest;
+mod maps;
 mod util;

@@ -30,6 +30,12 @@ enum Command {
     Ingest(IngestArgs),
     /// Simulate a campaign with the rig's digital twin: raw captures, campaign.toml, truth.json.
     Synth(SynthArgs),
+    /// Bifurcation diagram over a parameter sweep (grid of starts or continuation): bifurcation.parquet + PNGs.
+    Bifurcate(pendulum_jobs::bifurcate::BifurcateArgs),
+    /// Rotation-zone maps over two swept parameters, optionally two models compared: zones.parquet + PNGs.
+    Zones(pendulum_jobs::zones::ZonesArgs),
+    /// Replay a run (MCAP) with a fitted model: measured channels plus /sim/theta in one MCAP file.
+    Replay(pendulum_jobs::replay::ReplayArgs),
     /// Identify damping by the study's method (align, initial conditions, DE fit, validation);
     /// writes params/initial_conditions/residuals/convergence/runs Parquet tables and plots.
     Identify(IdentifyArgs),
@@ -240,6 +246,9 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             })?;
             print!("{s}");
         }
+        Command::Bifurcate(a) => print!("{}", pendulum_jobs::bifurcate::run(&a)?),
+        Command::Zones(a) => print!("{}", pendulum_jobs::zones::run(&a)?),
+        Command::Replay(a) => print!("{}", pendulum_jobs::replay::run(&a)?),
         Command::Demo(a) => {
             println!(
                 "Study configurations (R = 0.7, λ = 0.126), {0}×{0} starts each, steady states:",

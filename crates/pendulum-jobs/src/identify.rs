@@ -44,7 +44,11 @@ pub struct IdentifyJob {
 }
 
 /// Loads a pipeline file or the built-in one.
-pub fn load_pipeline(path: Option<&Path>, builtin: &str, name: &str) -> Result<(PipelineConfig, String), JobError> {
+pub fn load_pipeline(
+    path: Option<&Path>,
+    builtin: &str,
+    name: &str,
+) -> Result<(PipelineConfig, String), JobError> {
     match path {
         Some(p) => {
             let text = std::fs::read_to_string(p).map_err(|source| JobError::Io {
@@ -100,11 +104,15 @@ fn apply_overrides(p: &mut PipelineConfig, o: &FitOverrides) {
 }
 
 /// A progress bar over DE generations showing the current best.
-pub fn generation_bar(max_generations: u64) -> (ProgressBar, pendulum_process::identify::ProgressFn) {
+pub fn generation_bar(
+    max_generations: u64,
+) -> (ProgressBar, pendulum_process::identify::ProgressFn) {
     let bar = ProgressBar::new(max_generations);
     bar.set_style(
-        ProgressStyle::with_template("{prefix:>18} {bar:30} gen {pos}/{len} {msg} [{elapsed_precise}]")
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+        ProgressStyle::with_template(
+            "{prefix:>18} {bar:30} gen {pos}/{len} {msg} [{elapsed_precise}]",
+        )
+        .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     let b = bar.clone();
     let f: pendulum_process::identify::ProgressFn = Arc::new(move |label: &str, g| {
@@ -117,7 +125,12 @@ pub fn generation_bar(max_generations: u64) -> (ProgressBar, pendulum_process::i
 
 /// Residual histories of every fitted model on every run it saw (identify runs from the fit,
 /// validate runs from the validation).
-pub fn residuals_of(ctx: &Context, fit: &FitOutcome, validation: Option<&[RunFit]>, span_s: f64) -> Result<Vec<(String, Role, ResidualSeries)>, JobError> {
+pub fn residuals_of(
+    ctx: &Context,
+    fit: &FitOutcome,
+    validation: Option<&[RunFit]>,
+    span_s: f64,
+) -> Result<Vec<(String, Role, ResidualSeries)>, JobError> {
     let window = pendulum_process::identify::Window::default();
     let mut out = Vec::new();
     let mut all: Vec<&RunFit> = fit.runs.iter().collect();
@@ -125,8 +138,12 @@ pub fn residuals_of(ctx: &Context, fit: &FitOutcome, validation: Option<&[RunFit
         all.extend(v.iter());
     }
     for rf in all {
-        let Some(run) = ctx.runs.iter().find(|r| r.id == rf.id) else { continue };
-        let Some(al) = ctx.alignments.get(&rf.id) else { continue };
+        let Some(run) = ctx.runs.iter().find(|r| r.id == rf.id) else {
+            continue;
+        };
+        let Some(al) = ctx.alignments.get(&rf.id) else {
+            continue;
+        };
         let series = residual_series(run, al, &fit.spec, &fit.params, rf.ic_fit, &window, span_s)?;
         out.push((rf.id.clone(), rf.role, series));
     }
@@ -141,7 +158,10 @@ pub fn run(job: &IdentifyJob) -> Result<OutputSummary, JobError> {
     let pipeline_text = serde_json::to_string(&pipeline).unwrap_or_default();
     let runs: Vec<RunData> = load_runs(&job.input)?;
     if !runs.iter().any(|r| r.role == Role::Identify) {
-        return Err(JobError::Invalid(format!("{}: no run has role = \"identify\"", job.input.display())));
+        return Err(JobError::Invalid(format!(
+            "{}: no run has role = \"identify\"",
+            job.input.display()
+        )));
     }
     let mut ctx = Context::new(runs);
     let max_gen = pipeline.fit_mut().map_or(0, |f| f.max_generations);
@@ -157,7 +177,13 @@ pub fn run(job: &IdentifyJob) -> Result<OutputSummary, JobError> {
         b.finish_and_clear();
     }
     res?;
-    write_outputs(&ctx, &job.out, &pipeline_text, "pendulum identify", started.elapsed().as_secs_f64())
+    write_outputs(
+        &ctx,
+        &job.out,
+        &pipeline_text,
+        "pendulum identify",
+        started.elapsed().as_secs_f64(),
+    )
 }
 
 /// What to validate: fixed parameters from a params.parquet.
@@ -178,10 +204,19 @@ pub fn validate(job: &ValidateJob) -> Result<OutputSummary, JobError> {
     let given = crate::outputs::read_params(&job.params, job.model.as_deref())?;
     let runs = load_runs(&job.input)?;
     if !runs.iter().any(|r| r.role == Role::Validate) {
-        return Err(JobError::Invalid(format!("{}: no run has role = \"validate\"", job.input.display())));
+        return Err(JobError::Invalid(format!(
+            "{}: no run has role = \"validate\"",
+            job.input.display()
+        )));
     }
     let mut ctx = Context::new(runs);
     ctx.given = Some(given);
     pipeline.run(&mut ctx)?;
-    write_outputs(&ctx, &job.out, &pipeline_text, "pendulum validate", started.elapsed().as_secs_f64())
+    write_outputs(
+        &ctx,
+        &job.out,
+        &pipeline_text,
+        "pendulum validate",
+        started.elapsed().as_secs_f64(),
+    )
 }

@@ -8,7 +8,7 @@ use pendulum_log::{
     parse_rfc3339_utc_ns, AccelMsg, EncoderMsg, RunLogOptions, METADATA_CAPTURE_HEADER,
     METADATA_RUN,
 };
-use pendulum_rig::{Campaign, CaptureReader, IngestStats, ReadOptions, RunSpec, Sample};
+use pendulum_rig::{Campaign, CaptureReader, IngestStats, Location, ReadOptions, RunSpec, Sample};
 use rayon::prelude::*;
 
 use crate::runs::run_metadata;
@@ -107,7 +107,7 @@ impl std::fmt::Display for IngestSummary {
 /// Smallest unwrapped clock value among the first samples (frames of the two SD streams may be
 /// slightly out of order), so that every t_s is ≥ 0.
 fn first_t_us(spec: &RunSpec, opts: ReadOptions) -> Result<Option<u64>, JobError> {
-    let mut r = CaptureReader::open(&spec.file, opts)?;
+    let mut r = CaptureReader::open_run(spec, opts)?;
     let mut min: Option<u64> = None;
     for _ in 0..2000 {
         match r.next_sample()? {
@@ -118,13 +118,43 @@ fn first_t_us(spec: &RunSpec, opts: ReadOptions) -> Result<Option<u64>, JobError
     Ok(min)
 }
 
+/// The `/ingest_stats` message as `schemas/ingest_stats.json` documents it: `skipped` and
+/// `gaps` are counts, each skip's `at` is the line number or byte offset (`unit` says which);
+/// the kept gaps themselves go in `gap_list`.
+fn stats_json(stats: &IngestStats, format: &str) -> serde_json::Value {
+    let skips: Vec<serde_json::Value> = stats
+        .skips
+        .iter()
+        .map(|s| {
+            let (unit, at) = match s.at {
+                Location::Line(n) => ("line", n),
+                Location::Byte(n) => ("byte", n),
+            };
+            serde_json::json!({"at": at, "unit": unit, "reason": s.reason})
+        })
+        .collect();
+    serde_json::json!({
+        "format": format,
+        "encoder_samples": stats.encoder_samples,
+        "accel_samples": stats.accel_samples,
+        "skipped": stats.skipped_lines_or_frames,
+        "skipped_bytes": stats.skipped_bytes,
+        "gaps": stats.gap_count,
+        "clock_wraps": stats.clock_wraps,
+        "encoder_wraps": stats.encoder_wraps,
+        "truncated_tail_bytes": stats.truncated_tail_bytes,
+        "skips": skips,
+        "gap_list": serde_json::to_value(&stats.gaps).unwrap_or_default(),
+    })
+}
+
 fn ingest_run(c: &Campaign, spec: &RunSpec, out_dir: &Path) -> Result<IngestRow, JobError> {
     let opts = ReadOptions {
         g_m_s2: c.g_m_s2,
         ..ReadOptions::default()
     };
     let t0 = first_t_us(spec, opts)?.unwrap_or(0);
-    let mut reader = CaptureReader::open(&spec.file, opts)?;
+    let mut reader = CaptureReader::open_run(spec, opts)?;
     let mut warnings = Vec::new();
     let start_ns = match reader.header().started() {
         Some(s) => match parse_rfc3339_utc_ns(s) {
@@ -178,11 +208,7 @@ fn ingest_run(c: &Campaign, spec: &RunSpec, out_dir: &Path) -> Result<IngestRow,
         }
     }
     let stats = reader.stats().clone();
-    let mut json = serde_json::to_value(&stats).unwrap_or_default();
-    if let Some(o) = json.as_object_mut() {
-        o.insert("format".into(), reader.format().into());
-    }
-    w.write_stats(&json)?;
+    w.write_stats(&stats_json(&stats, reader.format()))?;
     let summary = w.finish()?;
     Ok(IngestRow {
         run_id: spec.id.clone(),

@@ -2,13 +2,16 @@
 //! does the work and returns a summary the binary prints. No argument parsing here, no printing
 //! of results (progress bars excepted).
 
+pub mod bifurcate;
 pub mod demo;
 pub mod identify;
 pub mod ingest;
 pub mod outputs;
+pub mod replay;
 pub mod runs;
 pub mod simulate;
 pub mod synth;
+pub mod zones;
 
 use std::path::PathBuf;
 

@@ -89,7 +89,9 @@ pub fn params_columns(ctx: &Context, fits: &[FitOutcome]) -> Vec<Column> {
         let (rig, omega_hz) = match first {
             Some(r) => (
                 r.rig.clone(),
-                ctx.alignments.get(&r.id).map_or(r.rig.omega_hz.unwrap_or(0.0), |a| a.omega_hz),
+                ctx.alignments
+                    .get(&r.id)
+                    .map_or(r.rig.omega_hz.unwrap_or(0.0), |a| a.omega_hz),
             ),
             None => continue,
         };
@@ -112,7 +114,11 @@ pub fn params_columns(ctx: &Context, fits: &[FitOutcome]) -> Vec<Column> {
         push("g_m_s2", "m/s²", rig.g_m_s2, row);
         push("omega_hz", "Hz", omega_hz, row);
         for p in ALL_EFFECT_PARAMS {
-            let v = if fit.spec.params.contains(&p) { fit.param(p) } else { f64::NAN };
+            let v = if fit.spec.params.contains(&p) {
+                fit.param(p)
+            } else {
+                f64::NAN
+            };
             push(p.name(), p.unit(), v, row);
         }
         push("f_obj", "rad", fit.f_obj, row);
@@ -124,7 +130,12 @@ pub fn params_columns(ctx: &Context, fits: &[FitOutcome]) -> Vec<Column> {
         push("wall_s", "s", fit.wall_s, row);
         push("seed", "1", fit.seed as f64, row);
         push("np", "1", fit.np as f64, row);
-        push("polished_f_obj", "rad", fit.polished.as_ref().map_or(f64::NAN, |p| p.1), row);
+        push(
+            "polished_f_obj",
+            "rad",
+            fit.polished.as_ref().map_or(f64::NAN, |p| p.1),
+            row,
+        );
     }
     let mut out = vec![strs("model", model)];
     for (name, unit, vals) in cols {
@@ -166,9 +177,15 @@ pub fn read_params(path: &Path, model: Option<&str>) -> Result<FitOutcome, JobEr
                 if let Some(a) = c.as_any().downcast_ref::<Float64Array>() {
                     return (!a.is_null(row)).then(|| a.value(row));
                 }
-                c.as_any().downcast_ref::<Int64Array>().map(|a| a.value(row) as f64)
+                c.as_any()
+                    .downcast_ref::<Int64Array>()
+                    .map(|a| a.value(row) as f64)
             };
-            let base = if name.starts_with("linear") { ModelSpec::linear() } else { ModelSpec::reference() };
+            let base = if name.starts_with("linear") {
+                ModelSpec::linear()
+            } else {
+                ModelSpec::reference()
+            };
             let mut spec = ModelSpec {
                 name: name.clone(),
                 params: base.params.clone(),
@@ -182,7 +199,10 @@ pub fn read_params(path: &Path, model: Option<&str>) -> Result<FitOutcome, JobEr
             let params = spec
                 .params
                 .iter()
-                .map(|p| get(p.name()).ok_or_else(|| bad(format!("model {name}: no column {}", p.name()))))
+                .map(|p| {
+                    get(p.name())
+                        .ok_or_else(|| bad(format!("model {name}: no column {}", p.name())))
+                })
                 .collect::<Result<Vec<f64>, _>>()?;
             return Ok(FitOutcome {
                 spec,
@@ -209,7 +229,10 @@ pub fn read_params(path: &Path, model: Option<&str>) -> Result<FitOutcome, JobEr
 }
 
 fn validation_of<'a>(ctx: &'a Context, model: &str) -> Option<&'a [RunFit]> {
-    ctx.validations.iter().find(|(m, _)| m == model).map(|(_, v)| v.as_slice())
+    ctx.validations
+        .iter()
+        .find(|(m, _)| m == model)
+        .map(|(_, v)| v.as_slice())
 }
 
 /// Every fitted or given model in the context.
@@ -250,10 +273,16 @@ pub fn write_outputs(
     {
         let first = models.first();
         let fitted: Vec<&RunFit> = first
-            .map(|m| m.runs.iter().chain(validation_of(ctx, &m.spec.name).unwrap_or(&[])).collect())
+            .map(|m| {
+                m.runs
+                    .iter()
+                    .chain(validation_of(ctx, &m.spec.name).unwrap_or(&[]))
+                    .collect()
+            })
             .unwrap_or_default();
         let mut c: Vec<Vec<f64>> = vec![Vec::new(); 14];
-        let (mut ids, mut roles, mut meas, mut sim, mut agree) = (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        let (mut ids, mut roles, mut meas, mut sim, mut agree) =
+            (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
         let mut meas_p = Vec::new();
         let mut sim_p = Vec::new();
         for r in &ctx.runs {
@@ -274,8 +303,15 @@ pub fn write_outputs(
                 al.map_or(f64::NAN, |a| a.free_segment_s.1),
                 ic.map_or(f64::NAN, |i| i.theta_rad),
                 ic.map_or(f64::NAN, |i| i.theta_dot_rad_s),
-                ctx.hanging.get(&r.id).copied().flatten().unwrap_or(f64::NAN),
-                fitted.iter().find(|f| f.id == r.id).map_or(f64::NAN, |f| f.e_theta),
+                ctx.hanging
+                    .get(&r.id)
+                    .copied()
+                    .flatten()
+                    .unwrap_or(f64::NAN),
+                fitted
+                    .iter()
+                    .find(|f| f.id == r.id)
+                    .map_or(f64::NAN, |f| f.e_theta),
             ];
             for (col, v) in c.iter_mut().zip(vals) {
                 col.push(v);
@@ -316,7 +352,10 @@ pub fn write_outputs(
         cols.push(Column::new("steady_agrees", ColumnData::Bool(agree)));
         let p = out.join("runs.parquet");
         opts.clone()
-            .meta("simulated_model", first.map_or("-".to_string(), |m| m.spec.name.clone()))
+            .meta(
+                "simulated_model",
+                first.map_or("-".to_string(), |m| m.spec.name.clone()),
+            )
             .write(&p, &cols)?;
         tables.push(p);
     }
@@ -331,11 +370,20 @@ pub fn write_outputs(
     for m in &models {
         let val = validation_of(ctx, &m.spec.name);
         for rf in m.runs.iter().chain(val.unwrap_or(&[])) {
-            let w0 = ctx.runs.iter().find(|r| r.id == rf.id).map_or(1.0, |r| r.rig.omega0_rad_s());
+            let w0 = ctx
+                .runs
+                .iter()
+                .find(|r| r.id == rf.id)
+                .map_or(1.0, |r| r.rig.omega0_rad_s());
             ic_run.push(rf.id.clone());
             ic_model.push(m.spec.name.clone());
             ic_role.push(rf.role.as_str().to_string());
-            for (col, v) in icv.iter_mut().zip([rf.ic_est[0], rf.ic_est[1] * w0, rf.ic_fit[0], rf.ic_fit[1] * w0]) {
+            for (col, v) in icv.iter_mut().zip([
+                rf.ic_est[0],
+                rf.ic_est[1] * w0,
+                rf.ic_fit[0],
+                rf.ic_fit[1] * w0,
+            ]) {
                 col.push(v);
             }
         }
@@ -351,12 +399,24 @@ pub fn write_outputs(
                 rs_run.push(id.clone());
                 rs_model.push(m.spec.name.clone());
                 rs_role.push(role.as_str().to_string());
-                let v = [s.t[k], s.tau_s[k], s.theta_meas[k], s.theta_sim[k], s.theta_meas[k] - s.theta_sim[k], s.theta_dot_meas[k], s.theta_dot_sim[k]];
+                let v = [
+                    s.t[k],
+                    s.tau_s[k],
+                    s.theta_meas[k],
+                    s.theta_sim[k],
+                    s.theta_meas[k] - s.theta_sim[k],
+                    s.theta_dot_meas[k],
+                    s.theta_dot_sim[k],
+                ];
                 for (col, x) in rsv.iter_mut().zip(v) {
                     col.push(x);
                 }
             }
-            let png = out.join(format!("history_{}_{}.png", m.spec.name.replace('+', "_"), id));
+            let png = out.join(format!(
+                "history_{}_{}.png",
+                m.spec.name.replace('+', "_"),
+                id
+            ));
             history_plot(&png, &id, &m.spec.name, role, &s)?;
             plots.push(png);
         }
@@ -368,8 +428,20 @@ pub fn write_outputs(
     }
     if !ic_run.is_empty() {
         let p = out.join("initial_conditions.parquet");
-        let mut cols = vec![strs("run_id", ic_run), strs("model", ic_model), strs("role", ic_role)];
-        for ((n, u), v) in [("theta0_est", "rad"), ("theta_dot0_est", "rad/s"), ("theta0_fit", "rad"), ("theta_dot0_fit", "rad/s")].iter().zip(icv) {
+        let mut cols = vec![
+            strs("run_id", ic_run),
+            strs("model", ic_model),
+            strs("role", ic_role),
+        ];
+        for ((n, u), v) in [
+            ("theta0_est", "rad"),
+            ("theta_dot0_est", "rad/s"),
+            ("theta0_fit", "rad"),
+            ("theta_dot0_fit", "rad/s"),
+        ]
+        .iter()
+        .zip(icv)
+        {
             cols.push(f64s(n, u, v));
         }
         opts.write(&p, &cols)?;
@@ -386,7 +458,11 @@ pub fn write_outputs(
     }
     if !rs_run.is_empty() {
         let p = out.join("residuals.parquet");
-        let mut cols = vec![strs("run_id", rs_run), strs("model", rs_model), strs("role", rs_role)];
+        let mut cols = vec![
+            strs("run_id", rs_run),
+            strs("model", rs_model),
+            strs("role", rs_role),
+        ];
         let names = [
             ("t", "1 (t = ω0·τ)"),
             ("tau_s", "s"),
@@ -404,7 +480,12 @@ pub fn write_outputs(
     }
 
     // Printed summary.
-    let _ = writeln!(text, "{} runs; outputs in {} ({wall_s:.1} s)", ctx.runs.len(), out.display());
+    let _ = writeln!(
+        text,
+        "{} runs; outputs in {} ({wall_s:.1} s)",
+        ctx.runs.len(),
+        out.display()
+    );
     for m in &models {
         let _ = write!(text, "model {:<28}", m.spec.name);
         for (p, v) in m.spec.params.iter().zip(&m.params) {
@@ -418,7 +499,11 @@ pub fn write_outputs(
         if let Some((x, f, n)) = &m.polished {
             let _ = writeln!(text, "  polished: {:?} f_obj={f:.4} ({n} evals)", x);
         }
-        for rf in m.runs.iter().chain(validation_of(ctx, &m.spec.name).unwrap_or(&[])) {
+        for rf in m
+            .runs
+            .iter()
+            .chain(validation_of(ctx, &m.spec.name).unwrap_or(&[]))
+        {
             let _ = writeln!(
                 text,
                 "  {:<8} {:<8} E_θ={:>9.4}  measured {:<22} simulated {:<22} {}",
@@ -427,7 +512,11 @@ pub fn write_outputs(
                 rf.e_theta,
                 rf.measured.to_string(),
                 rf.simulated.map_or("-".into(), |s| s.to_string()),
-                if rf.steady_agrees() { "agree" } else { "DIFFER" }
+                if rf.steady_agrees() {
+                    "agree"
+                } else {
+                    "DIFFER"
+                }
             );
         }
     }
@@ -443,7 +532,13 @@ pub fn write_outputs(
     })
 }
 
-fn history_plot(path: &Path, id: &str, model: &str, role: Role, s: &pendulum_process::identify::ResidualSeries) -> Result<(), JobError> {
+fn history_plot(
+    path: &Path,
+    id: &str,
+    model: &str,
+    role: Role,
+    s: &pendulum_process::identify::ResidualSeries,
+) -> Result<(), JobError> {
     let series = |label: &str, y: &[f64], color: usize| Series {
         label: label.into(),
         x: s.tau_s.clone(),
@@ -458,14 +553,20 @@ fn history_plot(path: &Path, id: &str, model: &str, role: Role, s: &pendulum_pro
                 title: "Angle".into(),
                 x_label: "time from the first at-speed peak (s)".into(),
                 y_label: "θ (rad)".into(),
-                series: vec![series("measured", &s.theta_meas, 0), series("simulated", &s.theta_sim, 1)],
+                series: vec![
+                    series("measured", &s.theta_meas, 0),
+                    series("simulated", &s.theta_sim, 1),
+                ],
                 ..Panel::default()
             },
             Panel {
                 title: "Angular velocity".into(),
                 x_label: "time from the first at-speed peak (s)".into(),
                 y_label: "dθ/dt (rad/s)".into(),
-                series: vec![series("measured", &s.theta_dot_meas, 0), series("simulated", &s.theta_dot_sim, 1)],
+                series: vec![
+                    series("measured", &s.theta_dot_meas, 0),
+                    series("simulated", &s.theta_dot_sim, 1),
+                ],
                 ..Panel::default()
             },
         ],

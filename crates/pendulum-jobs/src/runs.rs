@@ -25,7 +25,7 @@ pub fn read_capture(spec: &RunSpec, g_m_s2: f64) -> Result<ReadCapture, JobError
         g_m_s2,
         ..ReadOptions::default()
     };
-    let mut reader = CaptureReader::open(&spec.file, opts)?;
+    let mut reader = CaptureReader::open_run(spec, opts)?;
     let mut samples = Vec::new();
     while let Some(s) = reader.next_sample()? {
         samples.push(s);

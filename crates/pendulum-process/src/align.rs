@@ -24,7 +24,8 @@ pub struct AlignConfig {
     pub fit_window_s: f64,
     /// Quiet reference at the start of the capture (shaker off), s.
     pub quiet_s: f64,
-    /// A cycle is at speed when its amplitude is at least this fraction of the fitted one.
+    /// A cycle is at speed when its amplitude is at least this fraction of the fitted one
+    /// (amplitude ∝ speed², so 0.98 means 99 % of the speed).
     pub at_speed_fraction: f64,
     /// Relative range of real speeds searched around the set point.
     pub speed_search: f64,
@@ -37,7 +38,7 @@ impl Default for AlignConfig {
         Self {
             fit_window_s: 20.0,
             quiet_s: 1.0,
-            at_speed_fraction: 0.9,
+            at_speed_fraction: 0.98,
             speed_search: 0.02,
             settle_turns: 3.0,
         }
@@ -269,30 +270,40 @@ pub fn align(run: &RunData, cfg: &AlignConfig) -> Result<Alignment, ProcessError
     let (c0, gain, omega, tp) = (p[0], p[1], p[2], p[3] + t_mid);
     let period = 1.0 / omega;
 
-    // (4) Walk back from the first peak in the window while cycles carry the full amplitude.
-    let kk = r * (two_pi * omega).powi(2);
-    let cycle_gain = |tc: f64| -> Option<f64> {
-        let lo = t.partition_point(|&x| x < tc - 0.5 * period);
-        let hi = t.partition_point(|&x| x < tc + 0.5 * period);
-        if hi - lo < 8 {
+    // (4) Walk back from the first peak in the window while peaks carry the full amplitude.
+    // At a peak (φ = 0) f'(0) = 0, so the peak value is r(1 + λ)·φ̇²: a local quadratic fit of
+    // a_z around the peak measures the speed there, with no bias from the ramp before it.
+    let full = gain * r * (two_pi * omega).powi(2) * crank_f2(0.0, lambda);
+    let peak_ratio = |tc: f64| -> Option<f64> {
+        let half = 0.1 * period;
+        let lo = t.partition_point(|&x| x < tc - half);
+        let hi = t.partition_point(|&x| x <= tc + half);
+        if hi - lo < 6 {
             return None;
         }
-        let (mut num, mut den) = (0.0, 0.0);
-        for i in lo..hi {
-            let basis = kk * crank_f2(two_pi * omega * (t[i] - tp), lambda);
-            num += (az[i] - c0) * basis;
-            den += basis * basis;
-        }
-        Some(num / den)
+        let rows: Vec<Vec<f64>> = (lo..hi)
+            .map(|i| {
+                let x = (t[i] - tc) / half;
+                vec![1.0, x, x * x]
+            })
+            .collect();
+        let (b, _, _) = crate::linalg::lstsq(&rows, &az[lo..hi])?;
+        // Vertex of the parabola if it lies in the window, else the value at the predicted peak.
+        let peak = if b[2] < 0.0 && (b[1] / (2.0 * b[2])).abs() <= 1.0 {
+            b[0] - b[1] * b[1] / (4.0 * b[2])
+        } else {
+            b[0]
+        };
+        Some((peak - c0) / full)
     };
     let mut k = ((w_start - tp) / period).ceil();
     loop {
         let prev = tp + (k - 1.0) * period;
-        if prev - 0.5 * period < shaker_start_s - period {
+        if prev < shaker_start_s - period {
             break;
         }
-        match cycle_gain(prev) {
-            Some(g) if g >= cfg.at_speed_fraction * gain => k -= 1.0,
+        match peak_ratio(prev) {
+            Some(q) if q >= cfg.at_speed_fraction => k -= 1.0,
             _ => break,
         }
     }

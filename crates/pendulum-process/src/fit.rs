@@ -195,6 +195,10 @@ pub struct PreparedRun {
     pub tail_t: Vec<f64>,
     /// Tolerances the measured class used, for classifying the simulation the same way.
     pub classify: ClassifyOptions,
+    /// Multiple shooting: later segments restart from the measured state, as (index of the
+    /// segment's first sample in `t`, θ rad, dθ/dt dimensionless). Empty = single shooting over
+    /// the whole window (the study's method).
+    pub restarts: Vec<(usize, [f64; 2])>,
 }
 
 impl PreparedRun {
@@ -219,7 +223,8 @@ enum Window {
     Failed,
 }
 
-/// Simulates `model` from `y0` through `run`'s window (θ measured = θ + `offset`).
+/// Simulates `model` from `y0` through `run`'s window (θ measured = θ + `offset`); with
+/// restarts, each later segment starts again from its measured state.
 fn window_error(
     model: &Model,
     opts: &SimOptions,
@@ -229,26 +234,46 @@ fn window_error(
     bound: f64,
 ) -> Window {
     let mut sum = 0.0;
-    let mut k = 0;
     let mut end = y0;
-    let Some(&t_end) = run.t.last() else {
+    let n = run.t.len();
+    if n == 0 {
         return Window::Done(0.0, y0);
-    };
-    let res = integrate(model, opts, 0.0, y0, t_end, run.t.iter().copied(), |s| {
-        sum += (run.theta[k] - (s.theta + offset)).abs();
-        k += 1;
-        end = [s.theta, s.theta_dot];
-        if sum > bound {
-            ControlFlow::Break(())
-        } else {
-            ControlFlow::Continue(())
-        }
-    });
-    match res {
-        Ok(stats) if !stats.stopped_early => Window::Done(sum, end),
-        Ok(_) => Window::Abandoned(sum),
-        Err(_) => Window::Failed,
     }
+    let mut starts: Vec<(usize, f64, [f64; 2])> = vec![(0, 0.0, y0)];
+    for &(i, y) in &run.restarts {
+        if i > 0 && i < n {
+            starts.push((i, run.t[i], y));
+        }
+    }
+    for (s, &(i0, t_start, y_start)) in starts.iter().enumerate() {
+        let i1 = starts.get(s + 1).map_or(n, |x| x.0);
+        let t_end = run.t[i1 - 1];
+        let mut k = i0;
+        let res = integrate(
+            model,
+            opts,
+            t_start,
+            y_start,
+            t_end,
+            run.t[i0..i1].iter().copied(),
+            |smp| {
+                sum += (run.theta[k] - (smp.theta + offset)).abs();
+                k += 1;
+                end = [smp.theta, smp.theta_dot];
+                if sum > bound {
+                    ControlFlow::Break(())
+                } else {
+                    ControlFlow::Continue(())
+                }
+            },
+        );
+        match res {
+            Ok(stats) if !stats.stopped_early => {}
+            Ok(_) => return Window::Abandoned(sum),
+            Err(_) => return Window::Failed,
+        }
+    }
+    Window::Done(sum, end)
 }
 
 /// The simulated steady state over the run's tail, classified like the measurement

@@ -26,6 +26,11 @@ pub struct Window {
     pub window_s: f64,
     /// Samples per second used in E_θ (the encoder is decimated to this).
     pub sample_hz: f64,
+    /// Multiple shooting: segment length, s; each segment after the first restarts from the
+    /// measured state (local polynomial fit). `None` = one trajectory over the whole window, the
+    /// study's method, which chaotic transients make meaningless beyond a few seconds.
+    #[serde(default)]
+    pub segment_s: Option<f64>,
 }
 
 impl Default for Window {
@@ -33,6 +38,7 @@ impl Default for Window {
         Self {
             window_s: 10.0,
             sample_hz: 100.0,
+            segment_s: None,
         }
     }
 }
@@ -70,12 +76,32 @@ pub fn prepare_run(
         tail_t.push(w0 * (x - al.t0_s));
         x += period_s;
     }
+    let ts: Vec<f64> = idx.iter().map(|&i| w0 * (t[i] - al.t0_s)).collect();
+    let mut restarts = Vec::new();
+    if let Some(seg) = window
+        .segment_s
+        .filter(|s| *s > 0.0 && *s < window.window_s)
+    {
+        let ic_cfg = IcConfig::default();
+        let mut k = 1;
+        loop {
+            let t_seg = w0 * seg * k as f64;
+            let i = ts.partition_point(|&x| x < t_seg);
+            if i >= ts.len().saturating_sub(2) {
+                break;
+            }
+            let st = estimate_state(run, al.t0_s + ts[i] / w0, &ic_cfg)?;
+            restarts.push((i, [st.theta_rad, st.theta_dot_rad_s / w0]));
+            k += 1;
+        }
+    }
     Ok(PreparedRun {
+        restarts,
         id: run.id.clone(),
         role: run.role,
         rig: run.rig.clone(),
         omega_hz: al.omega_hz,
-        t: idx.iter().map(|&i| w0 * (t[i] - al.t0_s)).collect(),
+        t: ts,
         theta: idx.iter().map(|&i| th[i]).collect(),
         ic_est: [ic.theta_rad, ic.theta_dot_rad_s / w0],
         steady: *steady,
@@ -131,7 +157,7 @@ impl Default for FitConfig {
             max_generations: 400,
             seed: 1,
             early_abandon: true,
-            sim_tol: 1e-8,
+            sim_tol: 1e-6,
             polish: false,
             threads: None,
         }

@@ -31,6 +31,10 @@ impl Role {
 }
 
 /// One run, with the rig-table defaults already applied.
+///
+/// The rig keys (`m_kg` … `r_b_m`) are NaN when a `format = "timeseries"` run leaves them out
+/// (they are optional there); its file's description stays in `extra` (see
+/// [`crate::timeseries`]).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct RunSpec {
     pub id: String,
@@ -45,7 +49,8 @@ pub struct RunSpec {
     pub r_b_m: f64,
     /// Crank speed set point (the accelerometer says what it really was).
     pub omega_hz: Option<f64>,
-    /// `"serial-v1"` or `"sd-v2"`, if the experimenter said; readers detect it anyway.
+    /// `"serial-v1"` or `"sd-v2"`, if the experimenter said (readers detect it anyway), or
+    /// `"timeseries"` (a generic CSV/TSV described by the run's keys).
     pub format: Option<String>,
     /// Every key not listed above, from the rig table and the run (the run wins).
     pub extra: BTreeMap<String, Value>,
@@ -79,7 +84,7 @@ const RUN_KEYS: [&str; 10] = [
     "omega_hz",
     "format",
 ];
-const FORMATS: [&str; 2] = ["serial-v1", "sd-v2"];
+const FORMATS: [&str; 3] = ["serial-v1", "sd-v2", crate::timeseries::FORMAT];
 
 impl Campaign {
     /// Loads `dir/campaign.toml`, or the given `.toml` file (its folder is the campaign's).
@@ -223,11 +228,20 @@ impl Campaign {
                 .and_then(positive)
                 .ok_or_else(|| key_err(&label, key, "a positive number"))
         };
-        let m_kg = num("m_kg")?;
-        let l_m = num("l_m")?;
-        let crank_r_m = num("crank_r_m")?;
-        let rod_l_m = num("rod_L_m")?;
-        let r_b_m = num("r_b_m")?;
+        // A time-series run from another rig may leave the rig keys out (NaN = unknown).
+        let timeseries = matches!(merged.get("format"), Some(Value::String(s)) if s == crate::timeseries::FORMAT);
+        let rig_num = |key: &str| -> Result<f64, RigError> {
+            if timeseries && !merged.contains_key(key) {
+                Ok(f64::NAN)
+            } else {
+                num(key)
+            }
+        };
+        let m_kg = rig_num("m_kg")?;
+        let l_m = rig_num("l_m")?;
+        let crank_r_m = rig_num("crank_r_m")?;
+        let rod_l_m = rig_num("rod_L_m")?;
+        let r_b_m = rig_num("r_b_m")?;
         let omega_hz = match merged.get("omega_hz") {
             None => None,
             Some(_) => Some(num("omega_hz")?),
@@ -235,8 +249,18 @@ impl Campaign {
         let format = match merged.get("format") {
             None => None,
             Some(Value::String(s)) if FORMATS.contains(&s.as_str()) => Some(s.clone()),
-            Some(_) => return Err(key_err(&label, "format", "\"serial-v1\" or \"sd-v2\"")),
+            Some(_) => {
+                return Err(key_err(
+                    &label,
+                    "format",
+                    "\"serial-v1\", \"sd-v2\" or \"timeseries\"",
+                ))
+            }
         };
+        if timeseries {
+            // Checked here so that a bad key names campaign.toml; the keys stay in `extra`.
+            crate::timeseries::TimeseriesSpec::from_keys(&merged, path, &label)?;
+        }
         let extra = merged
             .into_iter()
             .filter(|(k, _)| !RUN_KEYS.contains(&k.as_str()))
@@ -317,11 +341,18 @@ impl Campaign {
             Value::String(file.to_string_lossy().into_owned()),
         );
         t.insert("role".into(), Value::String(r.role.as_str().into()));
-        t.insert("m_kg".into(), Value::Float(r.m_kg));
-        t.insert("l_m".into(), Value::Float(r.l_m));
-        t.insert("crank_r_m".into(), Value::Float(r.crank_r_m));
-        t.insert("rod_L_m".into(), Value::Float(r.rod_l_m));
-        t.insert("r_b_m".into(), Value::Float(r.r_b_m));
+        for (k, v) in [
+            ("m_kg", r.m_kg),
+            ("l_m", r.l_m),
+            ("crank_r_m", r.crank_r_m),
+            ("rod_L_m", r.rod_l_m),
+            ("r_b_m", r.r_b_m),
+        ] {
+            // NaN: left out by a time-series run.
+            if !v.is_nan() {
+                t.insert(k.into(), Value::Float(v));
+            }
+        }
         if let Some(w) = r.omega_hz {
             t.insert("omega_hz".into(), Value::Float(w));
         }

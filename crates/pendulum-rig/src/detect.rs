@@ -4,18 +4,34 @@ use std::fs::File;
 use std::io::{BufRead, BufReader};
 use std::path::Path;
 
+use crate::campaign::RunSpec;
 use crate::capture::{Header, IngestStats, Location, ReadOptions, Sample};
 use crate::error::RigError;
 use crate::sd::{SdReader, SYNC};
 use crate::serial::{SerialReader, COLUMN_LINE};
+use crate::timeseries::{TimeseriesReader, TimeseriesSpec, FORMAT as TIMESERIES};
 
-/// A capture of either format, opened from a file.
+/// A capture of any format, opened from a file.
 pub enum CaptureReader {
     Serial(SerialReader<BufReader<File>>),
     Sd(SdReader<BufReader<File>>),
+    /// A generic CSV/TSV time series described by its campaign run (`format = "timeseries"`).
+    Timeseries(TimeseriesReader<BufReader<File>>),
 }
 
 impl CaptureReader {
+    /// Opens a campaign run's capture: a `format = "timeseries"` run as the time series its
+    /// keys describe, any other run by [`CaptureReader::open`] (format told by the content).
+    pub fn open_run(spec: &RunSpec, opts: ReadOptions) -> Result<Self, RigError> {
+        if spec.format.as_deref() == Some(TIMESERIES) {
+            let ts = TimeseriesSpec::from_run(spec)?;
+            return Ok(CaptureReader::Timeseries(TimeseriesReader::open(
+                &spec.file, ts, opts,
+            )?));
+        }
+        Self::open(&spec.file, opts)
+    }
+
     /// Opens `path` and detects its format: `A5 5A` first → `sd-v2`; text starting (after
     /// blank space) with `#` or the column line → `serial-v1`; anything else is
     /// [`RigError::NotACapture`].
@@ -58,11 +74,12 @@ impl CaptureReader {
         })
     }
 
-    /// `"serial-v1"` or `"sd-v2"`.
+    /// `"serial-v1"`, `"sd-v2"` or `"timeseries"`.
     pub fn format(&self) -> &'static str {
         match self {
             CaptureReader::Serial(_) => "serial-v1",
             CaptureReader::Sd(_) => "sd-v2",
+            CaptureReader::Timeseries(_) => TIMESERIES,
         }
     }
 
@@ -71,6 +88,7 @@ impl CaptureReader {
         match self {
             CaptureReader::Serial(r) => r.next_sample(),
             CaptureReader::Sd(r) => r.next_sample(),
+            CaptureReader::Timeseries(r) => r.next_sample(),
         }
     }
 
@@ -78,6 +96,7 @@ impl CaptureReader {
         match self {
             CaptureReader::Serial(r) => r.header(),
             CaptureReader::Sd(r) => r.header(),
+            CaptureReader::Timeseries(r) => r.header(),
         }
     }
 
@@ -85,6 +104,7 @@ impl CaptureReader {
         match self {
             CaptureReader::Serial(r) => r.stats(),
             CaptureReader::Sd(r) => r.stats(),
+            CaptureReader::Timeseries(r) => r.stats(),
         }
     }
 }

@@ -20,4 +20,5 @@ pub use detect::CaptureReader;
 pub use error::RigError;
 pub use sd::{SdReader, SdWriter};
 pub use serial::{SerialReader, SerialWriter};
+pub mod timeseries;
 pub mod twin;

@@ -169,6 +169,9 @@ pub struct TwinRun {
     pub crank_r_m: Option<f64>,
 }
 
+/// Fraction of the set speed that counts as "at speed" for the truth's t = 0.
+pub const AT_SPEED: f64 = 0.99;
+
 fn default_free_s() -> f64 {
     4.0
 }
@@ -399,8 +402,24 @@ fn synthesize_run(
         omega_drift: d.omega_drift,
     };
     let model = Model::with_excitation(d, Excitation::Crank(drive));
-    // Aligned t = 0: the first φ = 2πn after the crank is at speed.
-    let t_speed = drive.t_at_speed();
+    // Aligned t = 0: the first φ = 2πn once the crank is at speed, taken as φ̇ ≥ 99 % of its
+    // final value (the motor's own speed tolerance): with the smooth ramp s(u) = 3u² − 2u³ that
+    // is s(u) = 0.99, solved by bisection.
+    let t_speed = match drive.t_start {
+        Some(ts) if spinup > 0.0 => {
+            let (mut lo, mut hi) = (0.0f64, 1.0f64);
+            for _ in 0..60 {
+                let u = 0.5 * (lo + hi);
+                if u * u * (3.0 - 2.0 * u) < AT_SPEED {
+                    lo = u;
+                } else {
+                    hi = u;
+                }
+            }
+            ts + hi * spinup
+        }
+        _ => drive.t_at_speed(),
+    };
     let (phi_speed, _, _) = drive.phase(t_speed);
     let two_pi = 2.0 * std::f64::consts::PI;
     let phi_target = (phi_speed / two_pi).ceil() * two_pi;

@@ -1,0 +1,481 @@
+//! Rotation-zone maps: two parameters swept on a grid (e.g. ω × R); per cell, the fraction of
+//! initial states that end in rotation and the mean rotation speed. Several models run on the
+//! same grid and starts, so two of them can be compared cell by cell.
+
+use std::path::Path;
+
+use pendulum_model::steady::steady_state_of;
+use pendulum_model::{ClassifyOptions, Dimensionless, Model, SimOptions, SteadyClass};
+use pendulum_plot::{save_heatmaps_side_by_side, Heatmap};
+use pendulum_report::{Column, ColumnData, TableOptions, TableSummary};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::style::describe_params;
+use crate::sweep::Sweep;
+use crate::{class_index, with_pool, MapsError};
+
+/// The grid and the simulations per cell.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ZoneConfig {
+    /// Swept along the map's x axis.
+    pub x: Sweep,
+    /// Swept along the map's y axis.
+    pub y: Sweep,
+    /// Initial states simulated in every cell.
+    pub starts: Vec<[f64; 2]>,
+    pub transient_periods: u32,
+    pub record_periods: u32,
+    pub sim: SimOptions,
+    pub classify: ClassifyOptions,
+    pub threads: Option<usize>,
+}
+
+impl ZoneConfig {
+    /// Defaults: 200 transient and 32 recorded periods, tolerance 1e-8.
+    pub fn new(x: Sweep, y: Sweep, starts: Vec<[f64; 2]>) -> Self {
+        Self {
+            x,
+            y,
+            starts,
+            transient_periods: 200,
+            record_periods: 32,
+            sim: SimOptions::with_tol(1e-8),
+            classify: ClassifyOptions::default(),
+            threads: None,
+        }
+    }
+
+    /// Simulations per model (the progress total is this times the number of models).
+    pub fn tasks(&self) -> u64 {
+        (self.x.len() * self.y.len() * self.starts.len()) as u64
+    }
+
+    fn validate(&self, models: &[(String, Dimensionless)]) -> Result<(), MapsError> {
+        if self.x.param == self.y.param {
+            return Err(MapsError::Invalid(format!(
+                "the x and y sweeps are both {}: choose two different parameters",
+                self.x.param.name()
+            )));
+        }
+        if self.x.is_empty() || self.y.is_empty() {
+            return Err(MapsError::Invalid("a sweep has no values".into()));
+        }
+        if self.starts.is_empty() {
+            return Err(MapsError::Invalid("no initial states".into()));
+        }
+        if self.record_periods < 2 {
+            return Err(MapsError::Invalid(format!(
+                "record {} periods: at least 2 are needed to classify",
+                self.record_periods
+            )));
+        }
+        if models.is_empty() {
+            return Err(MapsError::Invalid("no models to map".into()));
+        }
+        for (name, base) in models {
+            for ix in 0..self.x.len() {
+                for iy in 0..self.y.len() {
+                    let d = self.cell_params(base, ix, iy);
+                    d.validate().map_err(|e| {
+                        MapsError::Invalid(format!(
+                            "model {name} at {}={}, {}={}: {e}",
+                            self.x.param.name(),
+                            self.x.values[ix],
+                            self.y.param.name(),
+                            self.y.values[iy]
+                        ))
+                    })?;
+                    if !(d.omega > 0.0) {
+                        return Err(MapsError::Invalid(format!(
+                            "model {name}: omega = {} has no forcing period",
+                            d.omega
+                        )));
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// `base` with both swept parameters set to cell (ix, iy).
+    pub fn cell_params(&self, base: &Dimensionless, ix: usize, iy: usize) -> Dimensionless {
+        let d = self.x.apply(base, ix);
+        self.y.apply(&d, iy)
+    }
+}
+
+/// One cell of a map.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ZoneCell {
+    pub ix: usize,
+    pub iy: usize,
+    pub x: f64,
+    pub y: f64,
+    /// Starts per class, in [`SteadyClass::ALL`] order.
+    pub counts: [usize; 5],
+    pub starts: usize,
+    /// Mean |dθ/dt| (dimensionless) over the starts that rotate; NaN when none does.
+    pub mean_rotation_speed: f64,
+}
+
+impl ZoneCell {
+    pub fn fraction(&self, c: SteadyClass) -> f64 {
+        if self.starts == 0 {
+            0.0
+        } else {
+            self.counts[class_index(c)] as f64 / self.starts as f64
+        }
+    }
+
+    pub fn rotation_fraction(&self) -> f64 {
+        self.fraction(SteadyClass::RotationCcw) + self.fraction(SteadyClass::RotationCw)
+    }
+
+    /// Whether any start rotates.
+    pub fn rotates(&self) -> bool {
+        self.counts[class_index(SteadyClass::RotationCcw)]
+            + self.counts[class_index(SteadyClass::RotationCw)]
+            > 0
+    }
+}
+
+/// One model's map.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ZoneMap {
+    pub label: String,
+    pub base: Dimensionless,
+    pub config: ZoneConfig,
+    /// Row-major by y: cell (ix, iy) is `cells[iy * nx + ix]`.
+    pub cells: Vec<ZoneCell>,
+}
+
+impl ZoneMap {
+    pub fn cell(&self, ix: usize, iy: usize) -> &ZoneCell {
+        &self.cells[iy * self.config.x.len() + ix]
+    }
+
+    /// Cells where some start rotates.
+    pub fn rotating_cells(&self) -> usize {
+        self.cells.iter().filter(|c| c.rotates()).count()
+    }
+
+    fn grid(&self, f: impl Fn(&ZoneCell) -> f64) -> Vec<Vec<f64>> {
+        (0..self.config.y.len())
+            .map(|iy| {
+                (0..self.config.x.len())
+                    .map(|ix| f(self.cell(ix, iy)))
+                    .collect()
+            })
+            .collect()
+    }
+
+    fn heatmap(&self, title: String, marks: Vec<(usize, usize)>) -> Heatmap {
+        let c = &self.config;
+        Heatmap {
+            title,
+            x_label: c.x.param.label().to_string(),
+            y_label: c.y.param.label().to_string(),
+            x_edges: c.x.edges(),
+            y_edges: c.y.edges(),
+            values: self.grid(|cell| 100.0 * cell.rotation_fraction()),
+            value_label: "starts ending in rotation (%)".to_string(),
+            vmin: Some(0.0),
+            vmax: Some(100.0),
+            marks,
+            width: 900,
+            height: 700,
+        }
+    }
+
+    /// `reference model (λ = 0.126, β = 0.109, M = 0.007)`: the label and the parameters that
+    /// are not swept.
+    pub fn describe(&self) -> String {
+        let mut d = describe_params(&self.base, Some(self.config.x.param.name()));
+        // Drop the y parameter too.
+        let y = self.config.y.param.symbol();
+        d = d
+            .split(", ")
+            .filter(|p| !p.starts_with(&format!("{y} =")))
+            .collect::<Vec<_>>()
+            .join(", ");
+        format!("{} model ({d})", self.label)
+    }
+
+    /// Two heat maps side by side: the fraction of starts ending in rotation and the mean
+    /// rotation speed.
+    pub fn plot(&self, path: &Path) -> Result<(), MapsError> {
+        let frac = self.heatmap("starts ending in rotation".into(), Vec::new());
+        let speed_vals = self.grid(|cell| cell.mean_rotation_speed);
+        let vmax = speed_vals
+            .iter()
+            .flatten()
+            .copied()
+            .filter(|v| v.is_finite())
+            .fold(0.0f64, f64::max);
+        let speed = Heatmap {
+            title: "mean rotation speed of the rotating starts".into(),
+            values: speed_vals,
+            value_label: "mean |dθ/dt| (dimensionless; grey: no rotation)".into(),
+            vmin: Some(0.0),
+            vmax: Some(if vmax > 0.0 { vmax } else { 1.0 }),
+            ..frac.clone()
+        };
+        save_heatmaps_side_by_side(
+            &[frac, speed],
+            &format!(
+                "Rotation zones, {}: {} starts per cell, {} + {} periods",
+                self.describe(),
+                self.config.starts.len(),
+                self.config.transient_periods,
+                self.config.record_periods
+            ),
+            path,
+        )?;
+        Ok(())
+    }
+}
+
+/// Runs every model on the same grid and starts, in parallel over (model, cell, start).
+/// `progress` is called with 1 per finished simulation.
+pub fn run(
+    models: &[(String, Dimensionless)],
+    cfg: &ZoneConfig,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Result<Vec<ZoneMap>, MapsError> {
+    cfg.validate(models)?;
+    let (nx, ny, ns) = (cfg.x.len(), cfg.y.len(), cfg.starts.len());
+    let tasks: Vec<(usize, usize, usize, usize)> = (0..models.len())
+        .flat_map(|m| {
+            (0..ny).flat_map(move |iy| {
+                (0..nx).flat_map(move |ix| (0..ns).map(move |s| (m, ix, iy, s)))
+            })
+        })
+        .collect();
+    let results = with_pool(cfg.threads, || {
+        tasks
+            .par_iter()
+            .map(|&(m, ix, iy, s)| {
+                let d = cfg.cell_params(&models[m].1, ix, iy);
+                let r = steady_state_of(
+                    &Model::new(d),
+                    &cfg.sim,
+                    cfg.starts[s],
+                    0.0,
+                    cfg.transient_periods,
+                    cfg.record_periods,
+                    &cfg.classify,
+                )
+                .map(|(st, _, _)| st);
+                progress(1);
+                r
+            })
+            .collect::<Result<Vec<_>, _>>()
+    })??;
+    let mut maps = Vec::with_capacity(models.len());
+    let mut it = results.into_iter();
+    for (label, base) in models {
+        let mut cells = Vec::with_capacity(nx * ny);
+        for iy in 0..ny {
+            for ix in 0..nx {
+                let mut counts = [0usize; 5];
+                let (mut speed_sum, mut n_rot) = (0.0, 0usize);
+                for st in it.by_ref().take(ns) {
+                    counts[class_index(st.class)] += 1;
+                    if st.class.is_rotation() {
+                        speed_sum += st.mean_theta_dot.abs();
+                        n_rot += 1;
+                    }
+                }
+                cells.push(ZoneCell {
+                    ix,
+                    iy,
+                    x: cfg.x.values[ix],
+                    y: cfg.y.values[iy],
+                    counts,
+                    starts: ns,
+                    mean_rotation_speed: if n_rot > 0 {
+                        speed_sum / n_rot as f64
+                    } else {
+                        f64::NAN
+                    },
+                });
+            }
+        }
+        maps.push(ZoneMap {
+            label: label.clone(),
+            base: *base,
+            config: cfg.clone(),
+            cells,
+        });
+    }
+    Ok(maps)
+}
+
+/// Where two maps on the same grid disagree about rotation.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct Comparison {
+    /// Cells (ix, iy) where the first map rotates and the second does not.
+    pub only_a: Vec<(usize, usize)>,
+    /// Cells where the second rotates and the first does not.
+    pub only_b: Vec<(usize, usize)>,
+    /// Cells where both rotate.
+    pub both: usize,
+    /// Cells where neither does.
+    pub neither: usize,
+}
+
+impl Comparison {
+    /// All disagreeing cells.
+    pub fn disagree(&self) -> Vec<(usize, usize)> {
+        let mut v = self.only_a.clone();
+        v.extend(&self.only_b);
+        v.sort_unstable();
+        v
+    }
+}
+
+/// Compares two maps on the same grid cell by cell.
+pub fn compare(a: &ZoneMap, b: &ZoneMap) -> Result<Comparison, MapsError> {
+    if a.config.x != b.config.x || a.config.y != b.config.y || a.cells.len() != b.cells.len() {
+        return Err(MapsError::Invalid(format!(
+            "maps {} and {} are not on the same grid",
+            a.label, b.label
+        )));
+    }
+    let mut c = Comparison::default();
+    for (ca, cb) in a.cells.iter().zip(&b.cells) {
+        match (ca.rotates(), cb.rotates()) {
+            (true, false) => c.only_a.push((ca.ix, ca.iy)),
+            (false, true) => c.only_b.push((ca.ix, ca.iy)),
+            (true, true) => c.both += 1,
+            (false, false) => c.neither += 1,
+        }
+    }
+    Ok(c)
+}
+
+/// The two maps' rotation fractions side by side, the cells where exactly one of them rotates
+/// marked with a dot on both.
+pub fn plot_comparison(a: &ZoneMap, b: &ZoneMap, path: &Path) -> Result<Comparison, MapsError> {
+    let cmp = compare(a, b)?;
+    let marks = cmp.disagree();
+    let maps = [
+        a.heatmap(a.describe(), marks.clone()),
+        b.heatmap(b.describe(), marks),
+    ];
+    save_heatmaps_side_by_side(
+        &maps,
+        &format!(
+            "Rotation zones, {} vs {} ({} starts per cell). Dots: exactly one model rotates ({} cells: {} only {}, {} only {})",
+            a.label,
+            b.label,
+            a.config.starts.len(),
+            cmp.only_a.len() + cmp.only_b.len(),
+            cmp.only_a.len(),
+            a.label,
+            cmp.only_b.len(),
+            b.label
+        ),
+        path,
+    )?;
+    Ok(cmp)
+}
+
+/// The maps as one table: a row per (model, cell). With two maps, `disagree` marks the cells
+/// where exactly one of them rotates.
+pub fn columns(maps: &[ZoneMap]) -> Result<Vec<Column>, MapsError> {
+    let Some(first) = maps.first() else {
+        return Err(MapsError::Invalid("no maps to write".into()));
+    };
+    let disagree: Option<Vec<(usize, usize)>> = match maps {
+        [a, b] => Some(compare(a, b)?.disagree()),
+        _ => None,
+    };
+    let (xp, yp) = (first.config.x.param, first.config.y.param);
+    let mut model = Vec::new();
+    let (mut x, mut y) = (Vec::new(), Vec::new());
+    let mut starts = Vec::new();
+    let mut frac = Vec::new();
+    let mut per_class: [Vec<f64>; 5] = Default::default();
+    let mut speed = Vec::new();
+    let mut dis = Vec::new();
+    for m in maps {
+        if m.config.x.param != xp || m.config.y.param != yp {
+            return Err(MapsError::Invalid(format!(
+                "map {} sweeps other parameters than {}",
+                m.label, first.label
+            )));
+        }
+        for c in &m.cells {
+            model.push(m.label.clone());
+            x.push(c.x);
+            y.push(c.y);
+            starts.push(c.starts as i64);
+            frac.push(c.rotation_fraction());
+            for (k, cl) in SteadyClass::ALL.iter().enumerate() {
+                per_class[k].push(c.fraction(*cl));
+            }
+            speed.push(c.mean_rotation_speed);
+            if let Some(d) = &disagree {
+                dis.push(d.binary_search(&(c.ix, c.iy)).is_ok());
+            }
+        }
+    }
+    let mut cols = vec![
+        Column::new("model", ColumnData::Str(model)),
+        Column::f64(xp.name(), "1", x).describe(xp.label()),
+        Column::f64(yp.name(), "1", y).describe(yp.label()),
+        Column::new("starts", ColumnData::I64(starts)).describe("initial states simulated"),
+        Column::f64("rotation_fraction", "1", frac)
+            .describe("fraction of starts ending in rotation (either direction)"),
+    ];
+    for (k, cl) in SteadyClass::ALL.iter().enumerate() {
+        cols.push(
+            Column::f64(
+                &format!("{}_fraction", cl.as_str()),
+                "1",
+                std::mem::take(&mut per_class[k]),
+            )
+            .describe("fraction of starts ending in this class"),
+        );
+    }
+    cols.push(
+        Column::f64("mean_rotation_speed", "1 (dθ/dt)", speed)
+            .describe("mean |dθ/dt| of the rotating starts, dimensionless; NaN if none"),
+    );
+    if disagree.is_some() {
+        cols.push(
+            Column::new("disagree", ColumnData::Bool(dis))
+                .describe("exactly one of the two models rotates in this cell"),
+        );
+    }
+    Ok(cols)
+}
+
+/// Writes [`columns`] to Parquet with the grid's description and `extra` in the metadata.
+pub fn write_parquet(
+    maps: &[ZoneMap],
+    path: &Path,
+    extra: &[(String, String)],
+) -> Result<TableSummary, MapsError> {
+    let cols = columns(maps)?;
+    let c = &maps[0].config;
+    let mut opts = TableOptions::new()
+        .meta("x", c.x.describe())
+        .meta("y", c.y.describe())
+        .meta("starts", c.starts.len().to_string())
+        .meta("transient_periods", c.transient_periods.to_string())
+        .meta("record_periods", c.record_periods.to_string())
+        .meta("tol", c.sim.rtol.to_string());
+    for m in maps {
+        opts = opts.meta(
+            &format!("params.{}", m.label),
+            serde_json::to_string(&m.base).unwrap_or_default(),
+        );
+    }
+    for (k, v) in extra {
+        opts = opts.meta(k, v.clone());
+    }
+    Ok(opts.write(path, &cols)?)
+}

@@ -1,0 +1,1131 @@
+//! Generic time-series captures (`format = "timeseries"` in `campaign.toml`): a CSV/TSV file of
+//! columns (a time column or a fixed sample rate, an angle column, optional accelerometer
+//! columns) from a rig that is not ours, read into the same [`Sample`]s as the rig's captures.
+//!
+//! The run entry describes the file (every key below also works in the `[rig]` table):
+//!
+//! ```toml
+//! [[run]]
+//! id = "small"
+//! file = "single_small_amplitude_1khz.csv"
+//! role = "identify"
+//! format = "timeseries"
+//! time_column = "t_s"        # seconds; or `sample_hz = 1000` when the file has no time column
+//! angle_column = "theta_rad"
+//! angle_unit = "rad"         # rad | deg | counts (then counts_per_rev = 40000)
+//! hanging_angle = 3.14159265 # the angle's value at the hanging position, in angle_unit
+//! # accel_z_column = "az"; accel_x_column = "ax"; accel_y_column = "ay"; accel_unit = "m/s2" | "g"
+//! ```
+//!
+//! Optional keys: `time_unit` (`s`, `ms`, `us`; default `s`), `delimiter` (`","`, `"\t"`, `";"`,
+//! `" "` for runs of blanks; default: detected from the column line), `counts_per_rev` also with
+//! `rad`/`deg` (then the encoder-equivalent count is filled in). Rig keys (`m_kg`, `l_m`, …) are
+//! optional for such runs; no `omega_hz` means no shaker.
+//!
+//! The file: optional `# key=value` lines (kept in the header, like the rig's), then one
+//! column-name line, then one line per sample. Same rules as the rig's readers: a damaged line
+//! (wrong number of fields, a field that is not a finite number) is skipped and reported with its
+//! line number; a time that does not increase is reported and its line skipped; a time that jumps
+//! ahead is believed only if the following lines continue from it; gaps are counted.
+//!
+//! What a sample becomes: `EncoderSample { t_us: time·1e6 (or index / sample_hz ·1e6),
+//! theta_rad: (angle − hanging_angle) in rad, count: the count relative to hanging for
+//! `counts`, floor(θ·cpr/2π) when `counts_per_rev` is given with another unit, else 0 }`, and,
+//! when accelerometer columns are given, an `AccelSample` at the same time (axes without a column
+//! read 0; `raw` is the equivalent at 8192 LSB/g, saturated, and the header says so).
+
+use std::collections::{BTreeMap, VecDeque};
+use std::f64::consts::TAU;
+use std::io::{self, BufRead};
+use std::path::{Path, PathBuf};
+
+use serde::Serialize;
+use toml::Value;
+
+use crate::campaign::RunSpec;
+use crate::capture::{
+    snippet, AccelSample, EncoderSample, GapTracker, Header, IngestStats, Location, ReadOptions,
+    Sample, CONFIRM_RECORDS, DEFAULT_ACCEL_LSB_PER_G,
+};
+use crate::error::RigError;
+
+/// The `format` value of such runs.
+pub const FORMAT: &str = "timeseries";
+
+/// The run keys this format reads (they stay in [`RunSpec::extra`]).
+pub const TIMESERIES_KEYS: [&str; 12] = [
+    "time_column",
+    "time_unit",
+    "sample_hz",
+    "angle_column",
+    "angle_unit",
+    "counts_per_rev",
+    "hanging_angle",
+    "accel_x_column",
+    "accel_y_column",
+    "accel_z_column",
+    "accel_unit",
+    "delimiter",
+];
+
+/// A line longer than this is garbage (a real line is a few dozen bytes per column).
+const MAX_LINE_BYTES: usize = 64 * 1024;
+/// Rows looked at to estimate the nominal sample period when only a time column is given.
+const RATE_PROBE_ROWS: usize = 33;
+
+/// The unit of the angle column.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum AngleUnit {
+    Rad,
+    Deg,
+    /// Encoder counts, `counts_per_rev` per revolution.
+    Counts,
+}
+
+impl AngleUnit {
+    pub fn as_str(&self) -> &'static str {
+        match self {
+            AngleUnit::Rad => "rad",
+            AngleUnit::Deg => "deg",
+            AngleUnit::Counts => "counts",
+        }
+    }
+}
+
+/// The unit of the accelerometer columns.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub enum AccelUnit {
+    /// m/s² (key value `"m/s2"`, also `"m/s^2"`, `"mps2"`).
+    MS2,
+    /// Multiples of the campaign's g.
+    G,
+}
+
+/// The column separator.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub enum Delimiter {
+    Byte(u8),
+    /// Runs of blanks (spaces or tabs).
+    Whitespace,
+}
+
+impl Delimiter {
+    fn name(&self) -> String {
+        match self {
+            Delimiter::Byte(b'\t') => "\\t".into(),
+            Delimiter::Byte(b) => char::from(*b).to_string(),
+            Delimiter::Whitespace => "whitespace".into(),
+        }
+    }
+
+    fn split<'a>(&self, line: &'a [u8]) -> Vec<&'a [u8]> {
+        match self {
+            Delimiter::Byte(d) => line.split(|b| b == d).collect(),
+            Delimiter::Whitespace => line
+                .split(|b| *b == b' ' || *b == b'\t')
+                .filter(|f| !f.is_empty())
+                .collect(),
+        }
+    }
+}
+
+/// A `format = "timeseries"` run's description of its file.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct TimeseriesSpec {
+    /// The time column (in `time_unit`); `None` = times from `sample_hz`.
+    pub time_column: Option<String>,
+    /// Seconds per unit of the time column (1, 1e-3 or 1e-6).
+    pub time_scale_s: f64,
+    /// The sample rate: the time base without a time column, the nominal rate (for gap
+    /// reports) with one.
+    pub sample_hz: Option<f64>,
+    pub angle_column: String,
+    pub angle_unit: AngleUnit,
+    pub counts_per_rev: Option<f64>,
+    /// The angle's value at the hanging position, in `angle_unit`.
+    pub hanging_angle: f64,
+    /// `[x, y, z]` accelerometer columns.
+    pub accel_columns: [Option<String>; 3],
+    pub accel_unit: AccelUnit,
+    /// `None` = detected from the column line.
+    pub delimiter: Option<Delimiter>,
+}
+
+impl TimeseriesSpec {
+    /// Reads and checks the keys of a run (rig table merged in). `path` (campaign.toml) and
+    /// `run` (its id) name the place in messages.
+    pub fn from_keys(
+        keys: &BTreeMap<String, Value>,
+        path: &Path,
+        run: &str,
+    ) -> Result<Self, RigError> {
+        let err = |key: &str, expected: &str| RigError::CampaignKey {
+            path: path.to_path_buf(),
+            run: Some(run.to_string()),
+            key: key.to_string(),
+            expected: expected.to_string(),
+        };
+        let string = |key: &str| -> Result<Option<String>, RigError> {
+            match keys.get(key) {
+                None => Ok(None),
+                Some(Value::String(s)) if !s.trim().is_empty() => Ok(Some(s.trim().to_string())),
+                Some(_) => Err(err(key, "a non-empty string (a column name)")),
+            }
+        };
+        let number = |key: &str, positive: bool| -> Result<Option<f64>, RigError> {
+            let v = match keys.get(key) {
+                None => return Ok(None),
+                Some(Value::Float(f)) => *f,
+                Some(Value::Integer(i)) => *i as f64,
+                Some(_) => {
+                    return Err(err(
+                        key,
+                        if positive {
+                            "a positive number"
+                        } else {
+                            "a number"
+                        },
+                    ))
+                }
+            };
+            if !v.is_finite() || (positive && v <= 0.0) {
+                return Err(err(
+                    key,
+                    if positive {
+                        "a positive number"
+                    } else {
+                        "a finite number"
+                    },
+                ));
+            }
+            Ok(Some(v))
+        };
+        let time_column = string("time_column")?;
+        let sample_hz = number("sample_hz", true)?;
+        if time_column.is_none() && sample_hz.is_none() {
+            return Err(err(
+                "time_column",
+                "a column name (or `sample_hz` when the file has no time column)",
+            ));
+        }
+        let time_scale_s = match keys.get("time_unit") {
+            None => 1.0,
+            Some(Value::String(s)) => match s.trim() {
+                "s" => 1.0,
+                "ms" => 1e-3,
+                "us" | "µs" => 1e-6,
+                _ => return Err(err("time_unit", "\"s\", \"ms\" or \"us\"")),
+            },
+            Some(_) => return Err(err("time_unit", "\"s\", \"ms\" or \"us\"")),
+        };
+        let angle_column =
+            string("angle_column")?.ok_or_else(|| err("angle_column", "a column name"))?;
+        let angle_unit = match keys.get("angle_unit") {
+            Some(Value::String(s)) => match s.trim() {
+                "rad" => AngleUnit::Rad,
+                "deg" => AngleUnit::Deg,
+                "counts" => AngleUnit::Counts,
+                _ => return Err(err("angle_unit", "\"rad\", \"deg\" or \"counts\"")),
+            },
+            _ => return Err(err("angle_unit", "\"rad\", \"deg\" or \"counts\"")),
+        };
+        let counts_per_rev = number("counts_per_rev", true)?;
+        if angle_unit == AngleUnit::Counts && counts_per_rev.is_none() {
+            return Err(err(
+                "counts_per_rev",
+                "a positive number (angle_unit = \"counts\" needs it)",
+            ));
+        }
+        let hanging_angle = number("hanging_angle", false)?.unwrap_or(0.0);
+        let accel_columns = [
+            string("accel_x_column")?,
+            string("accel_y_column")?,
+            string("accel_z_column")?,
+        ];
+        let accel_unit = match keys.get("accel_unit") {
+            None => AccelUnit::MS2,
+            Some(Value::String(s)) => match s.trim() {
+                "m/s2" | "m/s^2" | "m/s²" | "mps2" => AccelUnit::MS2,
+                "g" => AccelUnit::G,
+                _ => return Err(err("accel_unit", "\"m/s2\" or \"g\"")),
+            },
+            Some(_) => return Err(err("accel_unit", "\"m/s2\" or \"g\"")),
+        };
+        let delimiter = match keys.get("delimiter") {
+            None => None,
+            Some(Value::String(s)) => Some(match s.as_str() {
+                "," => Delimiter::Byte(b','),
+                "\t" | "\\t" | "tab" => Delimiter::Byte(b'\t'),
+                ";" => Delimiter::Byte(b';'),
+                " " | "whitespace" => Delimiter::Whitespace,
+                _ => {
+                    return Err(err(
+                        "delimiter",
+                        "\",\", \"\\t\", \";\" or \" \" (runs of blanks)",
+                    ))
+                }
+            }),
+            Some(_) => {
+                return Err(err(
+                    "delimiter",
+                    "\",\", \"\\t\", \";\" or \" \" (runs of blanks)",
+                ))
+            }
+        };
+        Ok(Self {
+            time_column,
+            time_scale_s,
+            sample_hz,
+            angle_column,
+            angle_unit,
+            counts_per_rev,
+            hanging_angle,
+            accel_columns,
+            accel_unit,
+            delimiter,
+        })
+    }
+
+    /// The spec of a campaign run (its keys are in [`RunSpec::extra`]); messages name the
+    /// capture file, since the run carries no campaign path.
+    pub fn from_run(spec: &RunSpec) -> Result<Self, RigError> {
+        Self::from_keys(&spec.extra, &spec.file, &spec.id)
+    }
+
+    /// Radians per unit of the angle column.
+    pub fn rad_per_unit(&self) -> f64 {
+        match self.angle_unit {
+            AngleUnit::Rad => 1.0,
+            AngleUnit::Deg => std::f64::consts::PI / 180.0,
+            AngleUnit::Counts => TAU / self.counts_per_rev.unwrap_or(1.0),
+        }
+    }
+
+    fn has_accel(&self) -> bool {
+        self.accel_columns.iter().any(Option::is_some)
+    }
+}
+
+/// One line as read (content in the reader's buffer, without the line end).
+struct LineInfo {
+    number: u64,
+    bytes: u64,
+    overlong: bool,
+}
+
+/// A parsed data line, not yet accepted.
+#[derive(Debug, Clone, Copy)]
+struct Row {
+    line: u64,
+    bytes: u64,
+    /// Seconds, as in the file (time column) or from the data-line index.
+    t_s: f64,
+    angle: f64,
+    accel: [f64; 3],
+}
+
+/// Streaming reader of a time-series file.
+pub struct TimeseriesReader<R: BufRead> {
+    reader: R,
+    path: PathBuf,
+    spec: TimeseriesSpec,
+    opts: ReadOptions,
+    header: Header,
+    delim: Delimiter,
+    columns: Vec<String>,
+    ncols: usize,
+    idx_time: Option<usize>,
+    idx_angle: usize,
+    idx_accel: [Option<usize>; 3],
+    rad_per_unit: f64,
+    line_no: u64,
+    /// Data lines seen so far (good or bad): the sample index when times come from `sample_hz`.
+    data_lines: u64,
+    line: Vec<u8>,
+    lookahead: VecDeque<Row>,
+    drained: bool,
+    /// Nominal sample period, s (from `sample_hz` or estimated from the first rows).
+    period_s: f64,
+    /// Subtracted from every time so that none is negative (0 unless the first time is < 0).
+    t_origin_s: Option<f64>,
+    last_t_s: Option<f64>,
+    gaps: GapTracker,
+    pending_accel: Option<AccelSample>,
+    stats: IngestStats,
+}
+
+impl TimeseriesReader<io::BufReader<std::fs::File>> {
+    /// Opens `path` as described by `spec`.
+    pub fn open(
+        path: impl AsRef<Path>,
+        spec: TimeseriesSpec,
+        opts: ReadOptions,
+    ) -> Result<Self, RigError> {
+        let path = path.as_ref();
+        let file = std::fs::File::open(path).map_err(|e| RigError::io(path, e))?;
+        Self::new(
+            io::BufReader::with_capacity(64 * 1024, file),
+            path,
+            spec,
+            opts,
+        )
+    }
+}
+
+impl<R: BufRead> TimeseriesReader<R> {
+    /// Reads the `#` header and the column line and finds the columns. `path` names the file in
+    /// messages. A missing column is an error naming the file, the column and the columns
+    /// present.
+    pub fn new(
+        reader: R,
+        path: impl AsRef<Path>,
+        spec: TimeseriesSpec,
+        opts: ReadOptions,
+    ) -> Result<Self, RigError> {
+        let rad_per_unit = spec.rad_per_unit();
+        let mut me = Self {
+            reader,
+            path: path.as_ref().to_path_buf(),
+            delim: spec.delimiter.unwrap_or(Delimiter::Byte(b',')),
+            spec,
+            opts,
+            header: Header::new(),
+            columns: Vec::new(),
+            ncols: 0,
+            idx_time: None,
+            idx_angle: 0,
+            idx_accel: [None; 3],
+            rad_per_unit,
+            line_no: 0,
+            data_lines: 0,
+            line: Vec::with_capacity(128),
+            lookahead: VecDeque::new(),
+            drained: false,
+            period_s: 0.0,
+            t_origin_s: None,
+            last_t_s: None,
+            gaps: GapTracker::new("timeseries", 1.0, 1.0),
+            pending_accel: None,
+            stats: IngestStats::default(),
+        };
+        let column_line = me.read_header()?;
+        me.find_columns(column_line)?;
+        me.fill_header();
+        // The nominal period: the sample rate if given, else the median step of the first rows.
+        me.period_s = match me.spec.sample_hz {
+            Some(hz) => 1.0 / hz,
+            None => {
+                while me.lookahead.len() < RATE_PROBE_ROWS && !me.drained {
+                    match me.next_row()? {
+                        Some(r) => me.lookahead.push_back(r),
+                        None => me.drained = true,
+                    }
+                }
+                let mut steps: Vec<f64> = me
+                    .lookahead
+                    .iter()
+                    .zip(me.lookahead.iter().skip(1))
+                    .map(|(a, b)| b.t_s - a.t_s)
+                    .filter(|d| *d > 0.0)
+                    .collect();
+                steps.sort_by(f64::total_cmp);
+                steps.get(steps.len() / 2).copied().unwrap_or(0.0)
+            }
+        };
+        if me.period_s > 0.0 {
+            me.gaps = GapTracker::new("timeseries", 1.0 / me.period_s, opts.gap_factor);
+            me.header
+                .set("sample_hz", format!("{}", round_sig(1.0 / me.period_s)));
+        } else {
+            me.gaps = GapTracker::new("timeseries", 1.0, f64::INFINITY);
+        }
+        Ok(me)
+    }
+
+    pub fn header(&self) -> &Header {
+        &self.header
+    }
+
+    pub fn stats(&self) -> &IngestStats {
+        &self.stats
+    }
+
+    /// The column names of the file, in order.
+    pub fn columns(&self) -> &[String] {
+        &self.columns
+    }
+
+    pub fn spec(&self) -> &TimeseriesSpec {
+        &self.spec
+    }
+
+    fn not_a_capture(&self, line: u64, reason: String) -> RigError {
+        RigError::NotACapture {
+            path: self.path.clone(),
+            at: Location::Line(line),
+            reason,
+        }
+    }
+
+    /// Reads `#` lines into the header; returns the line number of the column line (left in
+    /// `self.line`).
+    fn read_header(&mut self) -> Result<u64, RigError> {
+        loop {
+            let Some(info) = self.read_line()? else {
+                return Err(self.not_a_capture(
+                    self.line_no.max(1),
+                    "the file ends before its column-name line".into(),
+                ));
+            };
+            if info.overlong {
+                return Err(self.not_a_capture(
+                    info.number,
+                    format!("header line longer than {MAX_LINE_BYTES} bytes"),
+                ));
+            }
+            let mut content: &[u8] = &self.line;
+            if info.number == 1 {
+                content = content.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(content);
+            }
+            let text = String::from_utf8_lossy(content).trim().to_string();
+            if text.is_empty() {
+                continue;
+            }
+            if let Some(rest) = text.strip_prefix('#') {
+                if let Some((k, v)) = rest.split_once('=') {
+                    let k = k.trim();
+                    if !k.is_empty() {
+                        self.header
+                            .entries
+                            .push((k.to_string(), v.trim().to_string()));
+                    }
+                }
+                continue;
+            }
+            self.line = text.into_bytes();
+            return Ok(info.number);
+        }
+    }
+
+    fn find_columns(&mut self, line_number: u64) -> Result<(), RigError> {
+        if self.spec.delimiter.is_none() {
+            self.delim = detect_delimiter(&self.line);
+        }
+        let names: Vec<String> = self
+            .delim
+            .split(&self.line)
+            .iter()
+            .map(|f| {
+                let s = String::from_utf8_lossy(f);
+                s.trim()
+                    .trim_matches('"')
+                    .trim_matches('\'')
+                    .trim()
+                    .to_string()
+            })
+            .collect();
+        if names.iter().all(|n| n.parse::<f64>().is_ok()) {
+            return Err(self.not_a_capture(
+                line_number,
+                format!(
+                    "expected a column-name line (the file's columns must be named), found {}",
+                    snippet(&self.line)
+                ),
+            ));
+        }
+        self.columns = names;
+        self.ncols = self.columns.len();
+        let find = |me: &Self, key: &str, name: &str| -> Result<usize, RigError> {
+            me.columns.iter().position(|c| c == name).ok_or_else(|| {
+                me.not_a_capture(
+                    line_number,
+                    format!(
+                        "column `{name}` (key `{key}`) not found; the columns present are: {} \
+                         (delimiter `{}`)",
+                        me.columns
+                            .iter()
+                            .map(|c| format!("`{c}`"))
+                            .collect::<Vec<_>>()
+                            .join(", "),
+                        me.delim.name()
+                    ),
+                )
+            })
+        };
+        if let Some(tc) = self.spec.time_column.clone() {
+            self.idx_time = Some(find(self, "time_column", &tc)?);
+        }
+        let ac = self.spec.angle_column.clone();
+        self.idx_angle = find(self, "angle_column", &ac)?;
+        for (i, key) in ["accel_x_column", "accel_y_column", "accel_z_column"]
+            .iter()
+            .enumerate()
+        {
+            if let Some(c) = self.spec.accel_columns[i].clone() {
+                self.idx_accel[i] = Some(find(self, key, &c)?);
+            }
+        }
+        Ok(())
+    }
+
+    /// What the MCAP's capture-header record should say about this file.
+    fn fill_header(&mut self) {
+        let s = self.spec.clone();
+        let h = &mut self.header;
+        h.set("format", FORMAT);
+        h.set("columns", self.columns.join(","));
+        h.set("delimiter", self.delim.name());
+        match &s.time_column {
+            Some(c) => h.set("time_column", c.clone()),
+            None => h.set("time_column", "none (sample index / sample_hz)"),
+        }
+        h.set("angle_column", s.angle_column.clone());
+        h.set("angle_unit", s.angle_unit.as_str());
+        h.set("hanging_angle", format!("{}", s.hanging_angle));
+        if let Some(cpr) = s.counts_per_rev {
+            h.set("encoder_cpr", format!("{cpr}"));
+        }
+        if s.has_accel() {
+            let names = ["x", "y", "z"];
+            for (i, c) in s.accel_columns.iter().enumerate() {
+                h.set(
+                    format!("accel_{}_column", names[i]),
+                    c.clone().unwrap_or_else(|| "none (reads 0)".into()),
+                );
+            }
+            h.set(
+                "accel_unit",
+                match s.accel_unit {
+                    AccelUnit::MS2 => "m/s2",
+                    AccelUnit::G => "g",
+                },
+            );
+            h.set("accel_lsb_per_g", format!("{DEFAULT_ACCEL_LSB_PER_G}"));
+            h.set(
+                "accel_raw",
+                "synthesized from the SI values at accel_lsb_per_g (saturated)",
+            );
+        }
+    }
+
+    /// Reads one line into `self.line`, keeping at most [`MAX_LINE_BYTES`] of it.
+    fn read_line(&mut self) -> Result<Option<LineInfo>, RigError> {
+        self.line.clear();
+        let mut bytes = 0u64;
+        let mut overlong = false;
+        loop {
+            let avail = match self.reader.fill_buf() {
+                Ok(b) => b,
+                Err(e) if e.kind() == io::ErrorKind::Interrupted => continue,
+                Err(e) => return Err(RigError::io(&self.path, e)),
+            };
+            if avail.is_empty() {
+                break;
+            }
+            let (chunk, used, done) = match avail.iter().position(|&b| b == b'\n') {
+                Some(i) => (&avail[..i], i + 1, true),
+                None => (avail, avail.len(), false),
+            };
+            let room = MAX_LINE_BYTES.saturating_sub(self.line.len());
+            if chunk.len() > room {
+                overlong = true;
+            }
+            self.line.extend_from_slice(&chunk[..chunk.len().min(room)]);
+            self.reader.consume(used);
+            bytes += used as u64;
+            if done {
+                break;
+            }
+        }
+        if bytes == 0 {
+            return Ok(None);
+        }
+        if self.line.last() == Some(&b'\r') {
+            self.line.pop();
+        }
+        self.line_no += 1;
+        Ok(Some(LineInfo {
+            number: self.line_no,
+            bytes,
+            overlong,
+        }))
+    }
+
+    /// The next parsable data line; damaged ones are recorded and skipped.
+    fn next_row(&mut self) -> Result<Option<Row>, RigError> {
+        loop {
+            let Some(info) = self.read_line()? else {
+                return Ok(None);
+            };
+            if self.line.iter().all(|b| b.is_ascii_whitespace()) && !info.overlong {
+                continue;
+            }
+            if self.line.first() == Some(&b'#') {
+                continue;
+            }
+            let index = self.data_lines;
+            self.data_lines += 1;
+            if info.overlong {
+                self.stats.skip(
+                    Location::Line(info.number),
+                    format!("line longer than {MAX_LINE_BYTES} bytes (garbage)"),
+                    info.bytes,
+                );
+                continue;
+            }
+            match self.parse_row(index) {
+                Ok((t_s, angle, accel)) => {
+                    return Ok(Some(Row {
+                        line: info.number,
+                        bytes: info.bytes,
+                        t_s,
+                        angle,
+                        accel,
+                    }))
+                }
+                Err(why) => {
+                    let reason = format!("{why}: {}", snippet(&self.line));
+                    self.stats
+                        .skip(Location::Line(info.number), reason, info.bytes);
+                }
+            }
+        }
+    }
+
+    fn parse_row(&self, index: u64) -> Result<(f64, f64, [f64; 3]), String> {
+        let fields = self.delim.split(&self.line);
+        if fields.len() != self.ncols {
+            let hint = if fields.len() > self.ncols {
+                "lines run together?"
+            } else {
+                "cut short?"
+            };
+            return Err(format!(
+                "{} fields, expected {} ({hint})",
+                fields.len(),
+                self.ncols
+            ));
+        }
+        let num = |i: usize| -> Result<f64, String> {
+            let s = std::str::from_utf8(fields[i]).unwrap_or("").trim();
+            let s = s.trim_matches('"');
+            match s.parse::<f64>() {
+                Ok(v) if v.is_finite() => Ok(v),
+                _ => Err(format!(
+                    "column `{}` is not a finite number",
+                    self.columns[i]
+                )),
+            }
+        };
+        let t_s = match self.idx_time {
+            Some(i) => num(i)? * self.spec.time_scale_s,
+            None => index as f64 / self.spec.sample_hz.unwrap_or(1.0),
+        };
+        let angle = num(self.idx_angle)?;
+        let mut accel = [0.0; 3];
+        for (a, idx) in accel.iter_mut().zip(self.idx_accel) {
+            if let Some(i) = idx {
+                *a = num(i)?;
+            }
+        }
+        Ok((t_s, angle, accel))
+    }
+
+    /// The next sample: each good line's encoder sample, then (with accelerometer columns) its
+    /// accelerometer sample. Errors only on I/O failure; damaged lines are skipped and counted
+    /// in [`Self::stats`].
+    pub fn next_sample(&mut self) -> Result<Option<Sample>, RigError> {
+        if let Some(a) = self.pending_accel.take() {
+            return Ok(Some(Sample::Accel(a)));
+        }
+        loop {
+            while self.lookahead.len() <= CONFIRM_RECORDS && !self.drained {
+                match self.next_row()? {
+                    Some(r) => self.lookahead.push_back(r),
+                    None => self.drained = true,
+                }
+            }
+            let Some(cand) = self.lookahead.pop_front() else {
+                return Ok(None);
+            };
+            if let Err(why) = self.check_time(&cand) {
+                self.stats.skip(Location::Line(cand.line), why, cand.bytes);
+                continue;
+            }
+            self.last_t_s = Some(cand.t_s);
+            let origin = *self.t_origin_s.get_or_insert(cand.t_s.min(0.0));
+            let t_us = ((cand.t_s - origin) * 1e6).round().max(0.0) as u64;
+            self.gaps.step(t_us, &mut self.stats);
+            let t_us_raw = (t_us & u64::from(u32::MAX)) as u32;
+            let rel = cand.angle - self.spec.hanging_angle;
+            let theta_rad = rel * self.rad_per_unit;
+            let count: i64 = match (self.spec.angle_unit, self.spec.counts_per_rev) {
+                (AngleUnit::Counts, _) => rel.round() as i64,
+                (_, Some(cpr)) => (theta_rad * cpr / TAU).floor() as i64,
+                (_, None) => 0,
+            };
+            self.stats.encoder_samples += 1;
+            if self.spec.has_accel() {
+                let g = self.opts.g_m_s2;
+                let si = match self.spec.accel_unit {
+                    AccelUnit::MS2 => cand.accel,
+                    AccelUnit::G => cand.accel.map(|a| a * g),
+                };
+                let raw = si.map(|a| {
+                    (a / g * DEFAULT_ACCEL_LSB_PER_G)
+                        .round()
+                        .clamp(f64::from(i16::MIN), f64::from(i16::MAX)) as i16
+                });
+                self.stats.accel_samples += 1;
+                self.pending_accel = Some(AccelSample {
+                    t_us_raw,
+                    t_us,
+                    raw,
+                    si_m_s2: si,
+                });
+            }
+            return Ok(Some(Sample::Encoder(EncoderSample {
+                t_us_raw,
+                t_us,
+                count_raw: count as i16,
+                count,
+                theta_rad,
+            })));
+        }
+    }
+
+    /// Order check with a few lines of lookahead: a time that does not increase is reported;
+    /// a time that jumps ahead by more than `gap_factor` periods is believed only when the next
+    /// lines continue from it (a garbled time would otherwise make every later line look out
+    /// of order).
+    fn check_time(&self, cand: &Row) -> Result<(), String> {
+        let Some(prev) = self.last_t_s else {
+            return Ok(());
+        };
+        if cand.t_s <= prev {
+            return Err(format!(
+                "time does not increase: {} s after {} s",
+                round_sig(cand.t_s),
+                round_sig(prev)
+            ));
+        }
+        let max_lone = self.opts.gap_factor.max(1.0) * self.period_s;
+        if self.period_s > 0.0 && cand.t_s - prev > max_lone {
+            let mut last = cand.t_s;
+            let mut confirmed = !self.lookahead.is_empty();
+            for r in self.lookahead.iter().take(CONFIRM_RECORDS) {
+                if !(r.t_s > last && r.t_s - last <= max_lone) {
+                    confirmed = false;
+                    break;
+                }
+                last = r.t_s;
+            }
+            if !confirmed {
+                return Err(format!(
+                    "time jumps ahead ({} s after {} s) and the next lines do not follow",
+                    round_sig(cand.t_s),
+                    round_sig(prev)
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The separator of a column line: the most frequent of tab, `;` and `,`; runs of blanks when
+/// none appears (a single column has no separator at all).
+fn detect_delimiter(line: &[u8]) -> Delimiter {
+    let count = |d: u8| line.iter().filter(|&&b| b == d).count();
+    let best = [b'\t', b';', b',']
+        .into_iter()
+        .map(|d| (count(d), d))
+        .max_by_key(|(n, _)| *n);
+    match best {
+        Some((n, d)) if n > 0 => Delimiter::Byte(d),
+        _ => Delimiter::Whitespace,
+    }
+}
+
+/// 10 significant digits, for messages and header values.
+fn round_sig(x: f64) -> f64 {
+    if x == 0.0 || !x.is_finite() {
+        return x;
+    }
+    let mag = 10f64.powi(9 - x.abs().log10().floor() as i32);
+    (x * mag).round() / mag
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn keys(text: &str) -> BTreeMap<String, Value> {
+        let t: toml::Table = toml::from_str(text).unwrap();
+        t.into_iter().collect()
+    }
+
+    fn spec(text: &str) -> TimeseriesSpec {
+        TimeseriesSpec::from_keys(&keys(text), Path::new("c/campaign.toml"), "r1").unwrap()
+    }
+
+    fn read_all(text: &str, s: TimeseriesSpec) -> (Vec<Sample>, IngestStats, Header) {
+        let mut r =
+            TimeseriesReader::new(text.as_bytes(), "x.csv", s, ReadOptions::default()).unwrap();
+        let mut v = Vec::new();
+        while let Some(x) = r.next_sample().unwrap() {
+            v.push(x);
+        }
+        (v, r.stats().clone(), r.header().clone())
+    }
+
+    fn enc(s: &[Sample]) -> Vec<EncoderSample> {
+        s.iter()
+            .filter_map(|x| match x {
+                Sample::Encoder(e) => Some(*e),
+                _ => None,
+            })
+            .collect()
+    }
+
+    #[test]
+    fn keys_are_checked() {
+        let s = spec("time_column = \"t_s\"\nangle_column = \"theta\"\nangle_unit = \"rad\"\nhanging_angle = 3.14159");
+        assert_eq!(s.time_column.as_deref(), Some("t_s"));
+        assert_eq!(s.angle_unit, AngleUnit::Rad);
+        assert_eq!(s.hanging_angle, 3.14159);
+        let bad = |text: &str, key: &str| {
+            let e = TimeseriesSpec::from_keys(&keys(text), Path::new("c/campaign.toml"), "r1")
+                .unwrap_err()
+                .to_string();
+            assert!(
+                e.contains("c/campaign.toml") && e.contains("r1") && e.contains(key),
+                "{e}"
+            );
+        };
+        bad("angle_column = \"a\"\nangle_unit = \"rad\"", "time_column");
+        bad("time_column = \"t\"\nangle_unit = \"rad\"", "angle_column");
+        bad("time_column = \"t\"\nangle_column = \"a\"", "angle_unit");
+        bad(
+            "time_column = \"t\"\nangle_column = \"a\"\nangle_unit = \"grad\"",
+            "angle_unit",
+        );
+        bad(
+            "time_column = \"t\"\nangle_column = \"a\"\nangle_unit = \"counts\"",
+            "counts_per_rev",
+        );
+        bad(
+            "sample_hz = -3\nangle_column = \"a\"\nangle_unit = \"rad\"",
+            "sample_hz",
+        );
+        bad(
+            "time_column = \"t\"\nangle_column = \"a\"\nangle_unit = \"rad\"\naccel_unit = \"furlong\"",
+            "accel_unit",
+        );
+    }
+
+    #[test]
+    fn reads_csv_with_time_column_and_hanging_offset() {
+        let s = spec("time_column = \"t_s\"\nangle_column = \"theta_rad\"\nangle_unit = \"rad\"\nhanging_angle = 3.0");
+        let text = "t_s,theta_rad\n0.000,3.5\n0.001,3.25\n0.002,3.0\n";
+        let (v, st, h) = read_all(text, s);
+        let e = enc(&v);
+        assert_eq!(e.len(), 3);
+        assert_eq!(e[1].t_us, 1000);
+        assert!((e[0].theta_rad - 0.5).abs() < 1e-12);
+        assert!((e[2].theta_rad).abs() < 1e-12);
+        assert_eq!(e[0].count, 0);
+        assert_eq!(st.encoder_samples, 3);
+        assert_eq!(st.accel_samples, 0);
+        assert_eq!(h.get("format"), Some("timeseries"));
+        assert_eq!(h.get("sample_hz"), Some("1000"));
+    }
+
+    #[test]
+    fn tsv_degrees_sample_rate_and_accel_in_g() {
+        let s = spec(
+            "sample_hz = 100\nangle_column = \"angle\"\nangle_unit = \"deg\"\n\
+             accel_z_column = \"az\"\naccel_unit = \"g\"",
+        );
+        let text = "# rig=other\nangle\taz\n90\t1.0\n-90\t0.5\n";
+        let (v, st, h) = read_all(text, s);
+        assert_eq!(h.get("rig"), Some("other"));
+        assert_eq!(st.accel_samples, 2);
+        let e = enc(&v);
+        assert!((e[0].theta_rad - std::f64::consts::FRAC_PI_2).abs() < 1e-12);
+        assert_eq!(e[1].t_us, 10_000);
+        match v[1] {
+            Sample::Accel(a) => {
+                assert!((a.si_m_s2[2] - 9.81).abs() < 1e-12);
+                assert_eq!(a.si_m_s2[0], 0.0);
+                assert_eq!(a.raw[2], 8192);
+            }
+            _ => panic!("expected accel after encoder"),
+        }
+    }
+
+    #[test]
+    fn counts_with_counts_per_rev() {
+        let s = spec(
+            "time_column = \"ms\"\ntime_unit = \"ms\"\nangle_column = \"enc\"\n\
+             angle_unit = \"counts\"\ncounts_per_rev = 4000\nhanging_angle = 2000",
+        );
+        let text = "ms;enc\n0;2000\n5;3000\n";
+        let (v, _, _) = read_all(text, s);
+        let e = enc(&v);
+        assert_eq!(e[1].t_us, 5000);
+        assert_eq!(e[1].count, 1000);
+        assert!((e[1].theta_rad - std::f64::consts::FRAC_PI_2).abs() < 1e-12);
+    }
+
+    #[test]
+    fn bad_lines_and_time_order_are_reported() {
+        let s = spec("time_column = \"t\"\nangle_column = \"a\"\nangle_unit = \"rad\"");
+        let mut text = String::from("t,a\n");
+        for i in 0..40 {
+            text.push_str(&format!("{},{}\n", i as f64 * 0.01, i));
+        }
+        text.push_str("0.39,7\n"); // line 42: time goes backwards
+        text.push_str("0.40,x\n"); // 43: not a number
+        text.push_str("0.41,1,2\n"); // 44: too many fields
+        text.push_str("55.0,1\n"); // 45: a garbled jump ahead
+        text.push_str("0.42,1\n0.43,1\n0.44,1\n0.45,1"); // no final newline: still read
+        let (v, st, _) = read_all(&text, s);
+        assert_eq!(enc(&v).len(), 44);
+        assert_eq!(st.skipped_lines_or_frames, 4);
+        let lines: Vec<Location> = st.skips.iter().map(|k| k.at).collect();
+        assert_eq!(
+            lines,
+            vec![
+                Location::Line(42),
+                Location::Line(43),
+                Location::Line(44),
+                Location::Line(45)
+            ]
+        );
+        assert!(
+            st.skips[0].reason.contains("does not increase"),
+            "{:?}",
+            st.skips
+        );
+        assert!(st.skips[1].reason.contains("`a`"), "{:?}", st.skips);
+        assert!(st.skips[3].reason.contains("jumps ahead"), "{:?}", st.skips);
+    }
+
+    #[test]
+    fn gaps_are_counted() {
+        let s = spec("time_column = \"t\"\nangle_column = \"a\"\nangle_unit = \"rad\"");
+        let mut text = String::from("t,a\n");
+        for i in (0..100).filter(|i| !(50..60).contains(i)) {
+            text.push_str(&format!("{},{}\n", i as f64 * 0.01, 0.1));
+        }
+        let (_, st, _) = read_all(&text, s);
+        assert_eq!(st.gap_count, 1);
+        assert_eq!(st.gaps[0].missing_samples_est, 10);
+    }
+
+    #[test]
+    fn missing_column_names_file_column_and_columns_present() {
+        let s = spec("time_column = \"t_s\"\nangle_column = \"theta\"\nangle_unit = \"rad\"");
+        let e = TimeseriesReader::new(
+            &b"t_s,theta_rad\n0,1\n"[..],
+            "data/run.csv",
+            s,
+            ReadOptions::default(),
+        )
+        .err()
+        .unwrap()
+        .to_string();
+        assert!(
+            e.contains("data/run.csv") && e.contains("`theta`") && e.contains("`t_s`, `theta_rad`"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn whitespace_and_no_header_line() {
+        let s = spec("sample_hz = 10\nangle_column = \"a\"\nangle_unit = \"rad\"");
+        let (v, _, _) = read_all("  a  \n 0.1 \n 0.2\n", s.clone());
+        assert_eq!(enc(&v).len(), 2);
+        let e = TimeseriesReader::new(&b"0.1,0.2\n"[..], "n.csv", s, ReadOptions::default())
+            .err()
+            .unwrap()
+            .to_string();
+        assert!(e.contains("n.csv") && e.contains("column-name"), "{e}");
+    }
+
+    const CAMPAIGN: &str = r#"
+name = "multiarm"
+[rig]
+r_b_m = 0.01
+
+[[run]]
+id = "small"
+file = "small.csv"
+role = "identify"
+format = "timeseries"
+time_column = "t_s"
+angle_column = "theta_rad"
+angle_unit = "rad"
+hanging_angle = 3.14159265358979
+note = "kept"
+"#;
+
+    #[test]
+    fn campaign_accepts_timeseries_runs_without_rig_keys() {
+        use crate::campaign::Campaign;
+        let c = Campaign::parse(CAMPAIGN, "/d/campaign.toml").unwrap();
+        let r = &c.runs[0];
+        assert_eq!(r.format.as_deref(), Some(FORMAT));
+        assert!(r.m_kg.is_nan() && r.l_m.is_nan() && r.crank_r_m.is_nan());
+        assert_eq!(r.r_b_m, 0.01);
+        assert_eq!(r.omega_hz, None);
+        assert_eq!(r.extra["angle_column"].as_str(), Some("theta_rad"));
+        assert_eq!(r.extra["note"].as_str(), Some("kept"));
+        let s = TimeseriesSpec::from_run(r).unwrap();
+        assert_eq!(s.angle_column, "theta_rad");
+        // Round trip: the unknown rig keys stay unknown.
+        let text = c.to_toml_string().unwrap();
+        let back = Campaign::parse(&text, "/d/campaign.toml").unwrap();
+        assert!(back.runs[0].m_kg.is_nan(), "{text}");
+        assert_eq!(back.runs[0].extra, r.extra);
+        // A bad key names campaign.toml, the run and the key.
+        let bad = CAMPAIGN.replace("angle_unit = \"rad\"", "angle_unit = \"radians\"");
+        let e = Campaign::parse(&bad, "/d/campaign.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("/d/campaign.toml") && e.contains("small") && e.contains("angle_unit"),
+            "{e}"
+        );
+        // Rig keys stay required for the rig's own formats.
+        let rig = CAMPAIGN.replace("format = \"timeseries\"", "format = \"serial-v1\"");
+        let e = Campaign::parse(&rig, "/d/campaign.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("m_kg"), "{e}");
+    }
+
+    #[test]
+    fn capture_reader_opens_a_timeseries_run() {
+        use crate::campaign::Campaign;
+        use crate::detect::CaptureReader;
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(
+            dir.path().join("small.csv"),
+            "t_s,theta_rad\n0.0,3.2\n0.001,3.3\n",
+        )
+        .unwrap();
+        std::fs::write(dir.path().join("campaign.toml"), CAMPAIGN).unwrap();
+        let c = Campaign::load(dir.path()).unwrap();
+        let mut r = CaptureReader::open_run(&c.runs[0], ReadOptions::default()).unwrap();
+        assert_eq!(r.format(), FORMAT);
+        let mut n = 0;
+        while let Some(Sample::Encoder(e)) = r.next_sample().unwrap() {
+            assert!((e.theta_rad - (3.2 + 0.1 * n as f64 - std::f64::consts::PI)).abs() < 1e-9);
+            n += 1;
+        }
+        assert_eq!(n, 2);
+        assert_eq!(r.stats().encoder_samples, 2);
+    }
+}
