@@ -144,7 +144,7 @@ fn bad_parameters_fail_with_a_clear_message() {
 
 #[test]
 fn demo_prints_the_study_contrast() {
-    let out = run(&["demo", "--grid", "2"]);
+    let out = run(&["demo", "--grid", "2", "--quick"]);
     assert!(
         out.status.success(),
         "{}",

@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 
 use pendulum_jobs::ingest;
 use pendulum_log::{read_run, AccelMsg, EncoderMsg, RunLog};
-use pendulum_model::{integrate, Excitation, Model, SimOptions};
+use pendulum_model::{integrate, CrankDrive, Excitation, Model, SimOptions};
 use pendulum_rig::twin::{synthesize, RunTruth, SensorModel, TwinCase, TwinFormat, TwinTruthFile};
 use pendulum_rig::{CaptureReader, Location, ReadOptions};
 use serde_json::{json, Value};
@@ -525,36 +525,55 @@ fn ideal_runs() -> String {
 /// How long after the truth's t = 0 the re-simulated θ is compared with the encoder.
 const FORCED_CHECK_S: f64 = 4.0;
 
-/// θ of the twin's pendulum, re-simulated from the truth at the given capture times (s since
-/// the first sample): the free decay from the release (the case's θ0, θ̇0) until the shaker
-/// starts, the forced motion from the truth's state at the aligned t = 0 for
-/// [`FORCED_CHECK_S`]. `None` elsewhere (the spin-up, whose crank phase the truth does not
-/// give, and later).
-fn resimulated_theta(
-    truth: &TwinTruthFile,
-    r: &RunTruth,
-    release: [f64; 2],
-    crank_r_m: f64,
-    times_s: &[f64],
-) -> Vec<Option<f64>> {
+/// The twin's run, rebuilt from the truth: the dimensionless model with the real crank speed and
+/// the crank drive as `twin.rs` documents it (shaker on at `shaker_start_s`, smooth spin-up over
+/// `spinup_turns` turns), its phase fixed by the truth's claim that t = 0 is a positive peak
+/// (φ = 0 mod 2π). Returns the model and ω0.
+fn twin_model(truth: &TwinTruthFile, r: &RunTruth, crank_r_m: f64, turns: f64) -> (Model, f64) {
     let mut phys = truth.params.clone();
     phys.omega_hz = r.omega_real_hz;
     phys.crank_r_m = crank_r_m;
     let d = phys.to_dimensionless();
     let w0 = phys.omega0_rad_s();
+    let mut drive = CrankDrive {
+        r_over_l: crank_r_m / phys.l_m,
+        lambda: d.lambda,
+        tan_delta: d.tan_delta,
+        omega: d.omega,
+        phi0: 0.0,
+        t_start: Some(r.shaker_start_s * w0),
+        // ∫φ̇ over the ramp = ω·T/2 = turns·2π.
+        spinup: 2.0 * turns * TAU / d.omega,
+        omega_drift: d.omega_drift,
+    };
+    drive.phi0 = -drive.phase(r.t0_s * w0).0;
+    (Model::with_excitation(d, Excitation::Crank(drive)), w0)
+}
+
+/// θ of the twin's pendulum re-simulated at the given capture times (s since the first sample):
+/// from the release (the case's θ0, θ̇0) up to the truth's t = 0, and from the truth's state at
+/// t = 0 for [`FORCED_CHECK_S`] (tumbling motion is chaotic: a restart from the truth's state,
+/// not bit-identical to the twin's integration through t = 0, drifts away exponentially, so
+/// later samples are `None`).
+fn resimulated_theta(
+    model: &Model,
+    w0: f64,
+    r: &RunTruth,
+    release: [f64; 2],
+    times_s: &[f64],
+) -> Vec<Option<f64>> {
     let opts = SimOptions::with_tol(1e-10);
     let mut out = vec![None; times_s.len()];
-    let mut run_segment = |model: &Model, t_from_s: f64, y0: [f64; 2], range: Vec<usize>| {
+    let mut run_segment = |t_from_s: f64, y0: [f64; 2], range: Vec<usize>| {
         let Some(&last) = range.last() else { return };
-        let t_end = (times_s[last] - t_from_s) * w0;
         let mut k = 0;
         integrate(
             model,
             &opts,
-            0.0,
+            t_from_s * w0,
             y0,
-            t_end,
-            range.iter().map(|&i| (times_s[i] - t_from_s) * w0),
+            times_s[last] * w0,
+            range.iter().map(|&i| times_s[i] * w0),
             |s| {
                 out[range[k]] = Some(s.theta);
                 k += 1;
@@ -563,25 +582,14 @@ fn resimulated_theta(
         )
         .expect("re-simulation");
     };
-    let free: Vec<usize> = (0..times_s.len())
-        .filter(|&i| times_s[i] < r.shaker_start_s)
+    let before: Vec<usize> = (0..times_s.len())
+        .filter(|&i| times_s[i] < r.t0_s)
         .collect();
-    // A few seconds only: tumbling motion is chaotic, and a restart from the truth's state
-    // (not bit-identical to the twin's integration through t0) drifts away exponentially.
-    let forced: Vec<usize> = (0..times_s.len())
+    let after: Vec<usize> = (0..times_s.len())
         .filter(|&i| times_s[i] >= r.t0_s && times_s[i] < r.t0_s + FORCED_CHECK_S)
         .collect();
-    let still = Model::with_excitation(d.clone(), Excitation::None);
-    run_segment(&still, 0.0, [release[0], release[1] / w0], free);
-    // From t = 0 on the crank is at speed with φ = 0: the study's alignment, which
-    // `Model::new` builds from the dimensionless set.
-    let driven = Model::new(d);
-    run_segment(
-        &driven,
-        r.t0_s,
-        [r.theta0_rad, r.theta_dot0_dimless],
-        forced,
-    );
+    run_segment(0.0, [release[0], release[1] / w0], before);
+    run_segment(r.t0_s, [r.theta0_rad, r.theta_dot0_dimless], after);
     out
 }
 
@@ -650,13 +658,9 @@ fn twin_round_trip_ideal_sensors_equals_truth() {
 
         // Quantisation: the true θ lies in the bin of every count (bin = [n, n+1) counts).
         let times: Vec<f64> = run.encoder.iter().map(|m| m.t_s).collect();
-        let sim = resimulated_theta(
-            &truth,
-            r,
-            [run_case.theta0_rad, run_case.theta_dot0_rad_s],
-            crank_r_m,
-            &times,
-        );
+        let (model, w0) = twin_model(&truth, r, crank_r_m, case.sensors.spinup_turns);
+        let release = [run_case.theta0_rad, run_case.theta_dot0_rad_s];
+        let sim = resimulated_theta(&model, w0, r, release, &times);
         let mut checked = 0;
         let mut worst = 0.0f64;
         for (m, th) in run.encoder.iter().zip(&sim) {
@@ -668,7 +672,7 @@ fn twin_round_trip_ideal_sensors_equals_truth() {
             checked += 1;
         }
         let rate = times.len() as f64 / duration;
-        let want = (run_case.free_s + FORCED_CHECK_S) * rate - 2.0;
+        let want = (r.t0_s + FORCED_CHECK_S) * rate - 2.0;
         assert!(checked as f64 >= want, "{id}: checked {checked} of {want}");
         // The re-simulation restarts from the truth's rounded state: allow 2 % of a count.
         assert!(
@@ -684,7 +688,26 @@ fn twin_round_trip_ideal_sensors_equals_truth() {
             "{id}: θ at t0 off by {err} rad"
         );
 
-        // Accelerometer: +1 g at rest (ideal: no offset, no noise), the crank's peak at t = 0.
+        // Accelerometer: the specific force of the rebuilt drive, 1 + ÿ/g, in LSB (ideal: no
+        // offset, noise or gain error; ±1 LSB for rounding at the twin's slightly different
+        // crank phase), at every sample, spin-up included.
+        let mut off_by_one = 0;
+        for m in &run.accel {
+            let (ay, ax) = model.excitation.accel(m.t_s * w0);
+            let z = ((1.0 + ay) * LSB_PER_G).round() as i16;
+            let x = (ax * LSB_PER_G).round() as i16;
+            assert!(
+                (m.az_raw - z).abs() <= 1 && m.ax_raw == x && m.ay_raw == 0,
+                "{id}: accel at t_s {}: {m:?}, expected z {z}, x {x}",
+                m.t_s
+            );
+            off_by_one += usize::from(m.az_raw != z);
+        }
+        assert!(
+            off_by_one * 100 < run.accel.len(),
+            "{id}: {off_by_one} off by one"
+        );
+        // +1 g at rest, the crank's peak at t = 0.
         let rest: Vec<&AccelMsg> = run
             .accel
             .iter()
@@ -1526,8 +1549,10 @@ theta0_rad = 0.8
 free_s = 2
 forced_s = 40
 ";
-    let mut sensors = SensorModel::default();
-    sensors.sd_corruptions_per_mb = 20.0;
+    let sensors = SensorModel {
+        sd_corruptions_per_mb: 20.0,
+        ..SensorModel::default()
+    };
     let case = twin_case(8, runs, sensors);
     let truth = synth(&case, dir.path());
     for r in &truth.runs {

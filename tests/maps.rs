@@ -382,8 +382,11 @@ fn is_png(path: &Path) -> bool {
     std::fs::read(path).is_ok_and(|b| b.len() > 1000 && b.starts_with(b"\x89PNG\r\n\x1a\n"))
 }
 
+/// A model row: name, a (kg/m), b (N·s/m), μ.
+type Row<'a> = (&'a str, f64, f64, f64);
+
 /// A params.parquet as `pendulum identify` writes it: one row per model.
-fn write_params(path: &Path, rows: &[(&str, f64, f64, f64)]) {
+fn write_params(path: &Path, rows: &[Row]) {
     use pendulum_model::Physical;
     use pendulum_report::{Column, ColumnData, TableOptions};
     let rig = Physical::default();
@@ -391,10 +394,10 @@ fn write_params(path: &Path, rows: &[(&str, f64, f64, f64)]) {
         "model",
         ColumnData::Str(rows.iter().map(|r| r.0.to_string()).collect()),
     )];
-    let mut f = |name: &str, v: &dyn Fn(&(&str, f64, f64, f64)) -> f64| {
+    let mut f = |name: &str, v: &dyn Fn(&Row) -> f64| {
         cols.push(Column::f64(name, "1", rows.iter().map(v).collect()));
     };
-    let dimless = |r: &(&str, f64, f64, f64)| {
+    let dimless = |r: &Row| {
         Physical {
             a_kg_m: r.1,
             b_n_s_m: r.2,
@@ -497,6 +500,14 @@ fn bifurcate_cli_writes_table_and_figures() {
     assert!(is_png(&a.join("bifurcation.png")));
     assert!(is_png(&a.join("bifurcation_classes.png")));
 
+    // The same dimensionless set by --param (the file's β and M, which went through SI and
+    // back, so that fractal basins see bit-identical parameters).
+    let file_d = pendulum_model::Physical {
+        b_n_s_m: b,
+        mu,
+        ..pendulum_model::Physical::default()
+    }
+    .to_dimensionless();
     let b_dir = dir.path().join("b");
     run(
         &[
@@ -505,9 +516,9 @@ fn bifurcate_cli_writes_table_and_figures() {
             "--param",
             "lambda=0.126",
             "--param",
-            &format!("beta={}", d.beta),
+            &format!("beta={}", file_d.beta),
             "--param",
-            &format!("M={}", d.m_coulomb),
+            &format!("M={}", file_d.m_coulomb),
         ],
         &b_dir,
     );

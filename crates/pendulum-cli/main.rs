@@ -30,11 +30,11 @@ enum Command {
     Ingest(IngestArgs),
     /// Simulate a campaign with the rig's digital twin: raw captures, campaign.toml, truth.json.
     Synth(SynthArgs),
-    /// Bifurcation diagram over a parameter sweep (grid of starts or continuation): bifurcation.parquet + PNGs.
+    /// Bifurcation diagram over a parameter sweep: bifurcation.parquet and PNGs.
     Bifurcate(pendulum_jobs::bifurcate::BifurcateArgs),
-    /// Rotation-zone maps over two swept parameters, optionally two models compared: zones.parquet + PNGs.
+    /// Rotation-zone maps over two swept parameters, two models compared: Parquet and PNGs.
     Zones(pendulum_jobs::zones::ZonesArgs),
-    /// Replay a run (MCAP) with a fitted model: measured channels plus /sim/theta in one MCAP file.
+    /// Replay a run with a fitted model: measured channels plus /sim/theta in one MCAP file.
     Replay(pendulum_jobs::replay::ReplayArgs),
     /// Identify damping by the study's method (align, initial conditions, DE fit, validation);
     /// writes params/initial_conditions/residuals/convergence/runs Parquet tables and plots.
@@ -159,6 +159,15 @@ struct DemoArgs {
     /// Initial-condition grid size per axis (grid × grid starts per configuration).
     #[arg(long, default_value_t = 4)]
     grid: usize,
+    /// Output folder for the demo's campaign, MCAP files, tables and plots.
+    #[arg(long, default_value = "demo-out")]
+    out: PathBuf,
+    /// DE generation cap of the demo's identification.
+    #[arg(long, default_value_t = 300)]
+    generations: u64,
+    /// Only the quick simulation table.
+    #[arg(long)]
+    quick: bool,
 }
 
 fn main() -> ExitCode {
@@ -266,6 +275,16 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                     print!(" {n:>12}");
                 }
                 println!();
+            }
+            if !a.quick {
+                println!("\nDigital twin campaign (truth: a = 0, b = 0.5 N·s/m, μ = 0.15) → raw captures → MCAP → identify:");
+                let c = demo::campaign(&a.out, a.generations, true)?;
+                print!("{}", c.ingest);
+                print!("{}", c.identify);
+                println!(
+                    "truth: a = {}, b = {}, μ = {}",
+                    c.truth.params.a_kg_m, c.truth.params.b_n_s_m, c.truth.params.mu
+                );
             }
         }
     }

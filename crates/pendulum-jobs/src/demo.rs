@@ -74,3 +74,46 @@ pub fn run(grid: usize) -> Result<Vec<DemoRow>, JobError> {
         })
         .collect()
 }
+
+/// The twin campaign the demo analyses (seven identify and three validate runs, both formats).
+pub const STUDY_CASE: &str = include_str!("../cases/study.toml");
+
+/// What the campaign part of the demo produced.
+#[derive(Debug, Clone)]
+pub struct DemoCampaign {
+    pub campaign_dir: std::path::PathBuf,
+    pub ingest: crate::ingest::IngestSummary,
+    pub identify: crate::outputs::OutputSummary,
+    pub truth: pendulum_rig::twin::TwinTruthFile,
+}
+
+/// Synthesises the built-in twin campaign into `out/campaign`, ingests it to `out/mcap`, and
+/// identifies the reference model from the MCAP files into `out/identify`.
+pub fn campaign(
+    out: &std::path::Path,
+    generations: u64,
+    progress: bool,
+) -> Result<DemoCampaign, JobError> {
+    use pendulum_rig::twin::{synthesize, TwinCase};
+    let campaign_dir = out.join("campaign");
+    let case = TwinCase::from_toml(STUDY_CASE, std::path::Path::new("<built-in study.toml>"))?;
+    let truth = synthesize(&case, &campaign_dir)?.truth_data;
+    let mcap_dir = out.join("mcap");
+    let ingest = crate::ingest::run(&campaign_dir, &mcap_dir, progress)?;
+    let identify = crate::identify::run(&crate::identify::IdentifyJob {
+        input: mcap_dir,
+        out: out.join("identify"),
+        pipeline: None,
+        overrides: crate::identify::FitOverrides {
+            generations: Some(generations),
+            ..Default::default()
+        },
+        progress,
+    })?;
+    Ok(DemoCampaign {
+        campaign_dir,
+        ingest,
+        identify,
+        truth,
+    })
+}

@@ -70,9 +70,14 @@ impl std::fmt::Display for ZonesSummary {
         let cells = c.x.len() * c.y.len();
         writeln!(
             f,
-            "rotation zones over {} × {} ({cells} cells; {} per cell, {} + {} periods): {} simulations in {:.1} s",
+            "rotation zones over {} × {} = {cells} cells",
             c.x.describe(),
             c.y.describe(),
+        )?;
+        writeln!(
+            f,
+            "  per cell {} starts ({}), {} + {} periods; {} simulations in {:.1} s",
+            c.starts.len(),
             self.ic_description,
             c.transient_periods,
             c.record_periods,

@@ -112,7 +112,7 @@ impl BifurcationConfig {
         for i in 0..self.sweep.len() {
             let d = self.sweep.apply(&self.base, i);
             d.validate()?;
-            if !(d.omega > 0.0) {
+            if d.omega <= 0.0 {
                 return Err(MapsError::Invalid(format!(
                     "omega = {} at sweep value {}: a Poincaré section needs forcing (omega > 0)",
                     d.omega, self.sweep.values[i]

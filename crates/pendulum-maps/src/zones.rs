@@ -86,7 +86,7 @@ impl ZoneConfig {
                             self.y.values[iy]
                         ))
                     })?;
-                    if !(d.omega > 0.0) {
+                    if d.omega <= 0.0 {
                         return Err(MapsError::Invalid(format!(
                             "model {name}: omega = {} has no forcing period",
                             d.omega
@@ -355,23 +355,21 @@ pub fn compare(a: &ZoneMap, b: &ZoneMap) -> Result<Comparison, MapsError> {
     Ok(c)
 }
 
-/// The two maps' rotation fractions side by side, the cells where exactly one of them rotates
-/// marked with a dot on both.
+/// The two maps' rotation fractions side by side; on each, a dot marks the cells where that
+/// model rotates and the other does not.
 pub fn plot_comparison(a: &ZoneMap, b: &ZoneMap, path: &Path) -> Result<Comparison, MapsError> {
     let cmp = compare(a, b)?;
-    let marks = cmp.disagree();
     let maps = [
-        a.heatmap(a.describe(), marks.clone()),
-        b.heatmap(b.describe(), marks),
+        a.heatmap(a.describe(), cmp.only_a.clone()),
+        b.heatmap(b.describe(), cmp.only_b.clone()),
     ];
     save_heatmaps_side_by_side(
         &maps,
         &format!(
-            "Rotation zones, {} vs {} ({} starts per cell). Dots: exactly one model rotates ({} cells: {} only {}, {} only {})",
+            "Rotation zones, {} vs {} ({} starts per cell). Dots: this model rotates, the other does not ({} cells {}, {} cells {})",
             a.label,
             b.label,
             a.config.starts.len(),
-            cmp.only_a.len() + cmp.only_b.len(),
             cmp.only_a.len(),
             a.label,
             cmp.only_b.len(),

@@ -114,6 +114,10 @@ pub struct SimOptions {
     pub h_max: f64,
     /// Give up after this many steps.
     pub max_steps: u64,
+    /// First step to try; `None` = 0.01. Restarted integrations (multiple shooting) pass the
+    /// last accepted step of the previous one, so they do not climb from a tiny step again.
+    #[serde(default)]
+    pub h_init: Option<f64>,
 }
 
 impl Default for SimOptions {
@@ -123,6 +127,7 @@ impl Default for SimOptions {
             atol: 1e-8,
             h_max: 0.5,
             max_steps: 50_000_000,
+            h_init: None,
         }
     }
 }
@@ -152,6 +157,8 @@ pub struct SimStats {
     pub ended_stuck: bool,
     /// True if the callback stopped the integration early.
     pub stopped_early: bool,
+    /// The last step size the controller proposed (dimensionless time).
+    pub last_h: f64,
 }
 
 /// Dormand–Prince 5(4) coefficients.
@@ -306,7 +313,11 @@ where
     }
     // Events that made no progress in a row (a guard against Zeno behaviour).
     let mut idle_events = 0u32;
-    let mut h = 1e-2_f64.min(opts.h_max);
+    let mut h = opts
+        .h_init
+        .filter(|h| *h > 0.0)
+        .unwrap_or(1e-2)
+        .min(opts.h_max);
     let mut err_old: f64 = 1e-4;
     let mut k1: Y = [0.0; 2];
     let mut need_k1 = true;
@@ -529,7 +540,10 @@ where
         t = t_new;
         y = y_new;
         k1 = k7;
-        h = h_next;
+        if !last {
+            h = h_next;
+            stats.last_h = h;
+        }
     }
     Ok(stats)
 }

@@ -245,13 +245,14 @@ fn window_error(
             starts.push((i, run.t[i], y));
         }
     }
+    let mut seg_opts = *opts;
     for (s, &(i0, t_start, y_start)) in starts.iter().enumerate() {
         let i1 = starts.get(s + 1).map_or(n, |x| x.0);
         let t_end = run.t[i1 - 1];
         let mut k = i0;
         let res = integrate(
             model,
-            opts,
+            &seg_opts,
             t_start,
             y_start,
             t_end,
@@ -268,7 +269,11 @@ fn window_error(
             },
         );
         match res {
-            Ok(stats) if !stats.stopped_early => {}
+            Ok(stats) if !stats.stopped_early => {
+                if stats.last_h > 0.0 {
+                    seg_opts.h_init = Some(stats.last_h);
+                }
+            }
             Ok(_) => return Window::Abandoned(sum),
             Err(_) => return Window::Failed,
         }

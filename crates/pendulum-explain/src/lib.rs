@@ -1,0 +1,15 @@
+//! pendulum-explain: what a damping model gets wrong, and which catalogue term (`effects.md`)
+//! fixes it.
+//!
+//! [`decay`]: free decays (no base motion) of a pendulum whose inertia may be unknown — turning
+//! points and the decay envelope, trajectory fits in the identifiable ratios (ω_n, damping per
+//! unit inertia), candidate terms with intervals and held-out gains, and what stays unexplained.
+
+pub mod decay;
+mod linalg;
+
+pub use decay::{
+    diagnose_decay, envelope, turning_points, Candidate, Coef, DecayDiagnosis, DecayError,
+    DecayOptions, EnvelopeFit, EnvelopeRow, Estimate, HeldOutScore, KnownRig, ModelFit,
+    ReferenceModel, Term, TurningPoint, Unexplained,
+};
