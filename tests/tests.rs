@@ -4,4 +4,5 @@ mod cli;
 mod identify;
 mod ingest;
 mod maps;
+mod real;
 mod util;

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use pendulum_jobs::{demo, identify, ingest, simulate, synth};
+use pendulum_jobs::{demo, discover, identify, ingest, simulate, synth};
 use pendulum_model::SteadyClass;
 
 #[derive(Parser)]
@@ -41,6 +41,9 @@ enum Command {
     Identify(IdentifyArgs),
     /// Validate given damping parameters (from a params.parquet) on a campaign's validate runs.
     Validate(ValidateArgs),
+    /// Show what the base model gets wrong, name the catalogue effect responsible (or say
+    /// unexplained), extend the model and measure the gain on the validate runs.
+    Discover(DiscoverArgs),
 }
 
 #[derive(clap::Args)]
@@ -113,6 +116,36 @@ struct ValidateArgs {
     /// Pipeline file (default: the built-in pipelines/validate.toml).
     #[arg(long)]
     pipeline: Option<PathBuf>,
+}
+
+#[derive(clap::Args)]
+struct DiscoverArgs {
+    /// A campaign folder or a folder of .mcap run logs (identify and validate runs).
+    input: PathBuf,
+    /// Output folder (tables, plots, report.md).
+    #[arg(long)]
+    out: PathBuf,
+    /// The model in hand: reference (a, b, μ) or linear (b only).
+    #[arg(long, value_enum, default_value_t = BaseArg::Reference)]
+    base: BaseArg,
+    /// Pipeline file (default: the built-in pipelines/discover.toml).
+    #[arg(long)]
+    pipeline: Option<PathBuf>,
+    /// Generation cap of the base fit.
+    #[arg(long)]
+    generations: Option<u64>,
+    /// Random seed.
+    #[arg(long)]
+    seed: Option<u64>,
+    /// No progress bar.
+    #[arg(long)]
+    quiet: bool,
+}
+
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum BaseArg {
+    Reference,
+    Linear,
 }
 
 #[derive(clap::Args)]
@@ -241,6 +274,21 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                     window_s: a.window_s,
                     no_early_abandon: a.no_early_abandon,
                 },
+                progress: !a.quiet,
+            })?;
+            print!("{s}");
+        }
+        Command::Discover(a) => {
+            let s = discover::run(&discover::DiscoverJob {
+                input: a.input,
+                out: a.out,
+                base: match a.base {
+                    BaseArg::Reference => pendulum_discover::Base::Reference,
+                    BaseArg::Linear => pendulum_discover::Base::Linear,
+                },
+                pipeline: a.pipeline,
+                generations: a.generations,
+                seed: a.seed,
                 progress: !a.quiet,
             })?;
             print!("{s}");

@@ -10,6 +10,6 @@ mod linalg;
 
 pub use decay::{
     diagnose_decay, envelope, turning_points, Candidate, Coef, DecayDiagnosis, DecayError,
-    DecayOptions, EnvelopeFit, EnvelopeRow, Estimate, HeldOutScore, KnownRig, ModelFit,
+    DecayOptions, EnvelopeFit, EnvelopeRow, Estimate, HeldOutScore, KnownRig, LossBand, ModelFit,
     ReferenceModel, Term, TurningPoint, Unexplained,
 };

@@ -14,7 +14,7 @@ pub fn inverse_spd(a: &[f64], n: usize) -> Option<Vec<f64>> {
             }
         })
         .collect();
-    if d.iter().any(|&x| x == 0.0) {
+    if d.contains(&0.0) {
         return None;
     }
     let mut m: Vec<f64> = (0..n * n).map(|k| a[k] * d[k / n] * d[k % n]).collect();

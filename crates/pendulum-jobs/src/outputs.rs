@@ -37,7 +37,9 @@ impl std::fmt::Display for OutputSummary {
     }
 }
 
-const ALL_EFFECT_PARAMS: [FitParam; 6] = [
+const ALL_EFFECT_PARAMS: [FitParam; 8] = [
+    FitParam::AccelDelay,
+    FitParam::SpeedDrift,
     FitParam::CoulombConstant,
     FitParam::ExtraInertia,
     FitParam::HorizontalBase,

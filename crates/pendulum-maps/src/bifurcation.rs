@@ -236,6 +236,11 @@ pub fn run(
     })
 }
 
+/// 1400 px, wider when the title would not fit (about 14 px per character at that size).
+fn figure_width(title: &str) -> u32 {
+    1400.max(title.chars().count() as u32 * 14 + 80).min(4000)
+}
+
 /// Class counts at one sweep value.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ValueSummary {
@@ -446,7 +451,7 @@ impl Bifurcation {
                 .map(|(c, n)| format!("{} ({n} of {total})", c.as_str()))
                 .collect(),
             category_colors: Some(DRAW_ORDER.iter().map(|c| class_color(*c)).collect()),
-            width: 1400,
+            width: figure_width(title),
             height: 800,
         }
         .save_png(path)?;
@@ -495,7 +500,7 @@ impl Bifurcation {
                 log_y: false,
                 y_range: Some((0.0, 100.0)),
             }],
-            width: 1400,
+            width: figure_width(title),
             height: 600,
         }
         .save_png(path)?;
@@ -508,7 +513,7 @@ impl Bifurcation {
         let mode = match c.mode {
             Mode::Grid => format!("{} starts", c.starts.len()),
             Mode::Continuation => {
-                format!("continuation up and down from {} start(s)", c.starts.len())
+                format!("continued up and down from {} starts", c.starts.len())
             }
         };
         format!(

@@ -19,7 +19,7 @@ pub const G_STANDARD_M_S2: f64 = 9.81;
 
 /// Effects of `effects.md` beyond the reference model, in SI units. `None`/`false` = absent.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, default)]
 pub struct Effects {
     /// `coulomb_constant`: load-independent dry torque T_c, N·m.
     pub coulomb_constant_t_c_nm: Option<f64>,

@@ -41,6 +41,10 @@ pub enum FitParam {
     PositionTorquePhase,
     /// `encoder_offset` θ_off, rad.
     EncoderOffset,
+    /// `accel_delay` Δ, s: the forcing leads the accelerometer-aligned clock by Δ.
+    AccelDelay,
+    /// `speed_drift` dΩ/dτ, Hz/s.
+    SpeedDrift,
 }
 
 impl FitParam {
@@ -56,6 +60,8 @@ impl FitParam {
             FitParam::PositionTorque => "position_torque.T_p",
             FitParam::PositionTorquePhase => "position_torque.phi_p",
             FitParam::EncoderOffset => "encoder_offset.theta_off",
+            FitParam::AccelDelay => "accel_delay.Delta",
+            FitParam::SpeedDrift => "speed_drift.dOmega_dtau",
         }
     }
 
@@ -69,6 +75,8 @@ impl FitParam {
             FitParam::HorizontalBase | FitParam::PositionTorquePhase | FitParam::EncoderOffset => {
                 "rad"
             }
+            FitParam::AccelDelay => "s",
+            FitParam::SpeedDrift => "Hz/s",
         }
     }
 
@@ -84,6 +92,8 @@ impl FitParam {
             FitParam::PositionTorque => (0.0, 0.1),
             FitParam::PositionTorquePhase => (-std::f64::consts::PI, std::f64::consts::PI),
             FitParam::EncoderOffset => (-0.2, 0.2),
+            FitParam::AccelDelay => (-0.05, 0.05),
+            FitParam::SpeedDrift => (-0.01, 0.01),
         }
     }
 
@@ -110,6 +120,8 @@ impl FitParam {
                 e.position_torque = Some(pt);
             }
             FitParam::EncoderOffset => e.encoder_offset_rad = Some(v),
+            FitParam::AccelDelay => e.accel_delay_s = Some(v),
+            FitParam::SpeedDrift => e.speed_drift_hz_per_s = Some(v),
         }
     }
 }
@@ -326,6 +338,20 @@ pub fn simulated_steady(
     let mut s = classify_poincare(&a[..n], &b[..n], &run.classify);
     s.mean_theta_dot /= run.period();
     Some(s)
+}
+
+/// The model of a physical parameter set, driven by the aligned crank (φ = ωt at t = 0), with
+/// `accel_delay` shifting the forcing: the accelerometer's peak came Δ after the true one, so the
+/// true crank angle is ω(t + Δ).
+pub fn model_for(phys: &Physical) -> Model {
+    let d = phys.to_dimensionless();
+    let mut m = Model::new(d);
+    if let (Some(delay_s), pendulum_model::Excitation::Crank(c)) =
+        (phys.effects.accel_delay_s, &mut m.excitation)
+    {
+        c.phi0 = d.omega * delay_s * phys.omega0_rad_s();
+    }
+    m
 }
 
 /// Cost value used for a trial whose simulation failed: finite (DE needs it) and huge.

@@ -890,10 +890,10 @@ mod tests {
 
     #[test]
     fn keys_are_checked() {
-        let s = spec("time_column = \"t_s\"\nangle_column = \"theta\"\nangle_unit = \"rad\"\nhanging_angle = 3.14159");
+        let s = spec("time_column = \"t_s\"\nangle_column = \"theta\"\nangle_unit = \"rad\"\nhanging_angle = 3.25");
         assert_eq!(s.time_column.as_deref(), Some("t_s"));
         assert_eq!(s.angle_unit, AngleUnit::Rad);
-        assert_eq!(s.hanging_angle, 3.14159);
+        assert_eq!(s.hanging_angle, 3.25);
         let bad = |text: &str, key: &str| {
             let e = TimeseriesSpec::from_keys(&keys(text), Path::new("c/campaign.toml"), "r1")
                 .unwrap_err()

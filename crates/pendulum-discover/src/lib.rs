@@ -1,0 +1,10 @@
+//! Discovery: show where the simulation departs from the rig (weak-form equation error), name
+//! the catalogue effect responsible (or say `unexplained`), extend the model, and measure the
+//! gain on runs the fit never saw.
+
+pub mod discover;
+pub mod screen;
+pub mod weak;
+
+pub use discover::{discover, DiagnosisRow, DiscoverConfig, Discovery};
+pub use screen::Base;

@@ -1,0 +1,258 @@
+//! Fast screening: regress the weak-form target on the base model's terms plus each catalogue
+//! candidate's terms, and rank candidates by the Bayesian information criterion.
+//!
+//! ΔBIC = n·ln(RSS₁/RSS₀) + Δk·ln n over the identify runs' windows; a candidate passes the
+//! screen with ΔBIC < −10 ("very strong" evidence). Candidates are added greedily (forward
+//! stepwise) so that pairs of effects are separated: after the best, the next must improve BIC
+//! again with the first already in.
+
+use pendulum_process::linalg::{inverse, solve};
+use serde::{Deserialize, Serialize};
+
+use crate::weak::{WeakRow, DELAY};
+
+/// The base models discover starts from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Base {
+    /// a, b, μ.
+    Reference,
+    /// b only (the classic model).
+    Linear,
+}
+
+impl Base {
+    pub fn name(self) -> &'static str {
+        match self {
+            Base::Reference => "reference",
+            Base::Linear => "linear",
+        }
+    }
+
+    /// Column indices of the base's own terms.
+    pub fn columns(self) -> Vec<usize> {
+        match self {
+            Base::Reference => vec![0, 1, 2],
+            Base::Linear => vec![0],
+        }
+    }
+}
+
+/// A catalogue candidate as the screen sees it: the columns it adds (or swaps in).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Candidate {
+    /// Catalogue name (effects.md).
+    pub effect: String,
+    /// Columns added to the regression.
+    pub add: Vec<usize>,
+    /// Base column it replaces (bearing_load_base_accel swaps the bearing load).
+    pub replaces: Option<usize>,
+    /// position_torque harmonic.
+    pub k: u32,
+}
+
+/// The candidates for a base model.
+pub fn candidates(base: Base) -> Vec<Candidate> {
+    let mut out = Vec::new();
+    let cand = |effect: &str, add: Vec<usize>| Candidate {
+        effect: effect.into(),
+        add,
+        replaces: None,
+        k: 0,
+    };
+    if base == Base::Linear {
+        out.push(cand("viscous_quadratic", vec![1]));
+        out.push(cand("coulomb_bearing", vec![2]));
+    }
+    if base == Base::Reference {
+        out.push(Candidate {
+            effect: "bearing_load_base_accel".into(),
+            add: vec![3],
+            replaces: Some(2),
+            k: 0,
+        });
+    }
+    out.push(cand("coulomb_constant", vec![4]));
+    for k in 1..=4u32 {
+        let i = 5 + 2 * (k as usize - 1);
+        out.push(Candidate {
+            effect: "position_torque".into(),
+            add: vec![i, i + 1],
+            replaces: None,
+            k,
+        });
+    }
+    out.push(cand("horizontal_base", vec![13]));
+    out.push(cand("extra_inertia", vec![14]));
+    out.push(cand("encoder_offset", vec![15]));
+    out.push(cand("accel_delay", vec![DELAY]));
+    out
+}
+
+/// An ordinary least-squares fit of the target on some columns.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Ols {
+    pub columns: Vec<usize>,
+    pub coef: Vec<f64>,
+    /// Standard errors.
+    pub se: Vec<f64>,
+    pub rss: f64,
+    pub n: usize,
+}
+
+impl Ols {
+    pub fn bic(&self) -> f64 {
+        let n = self.n as f64;
+        n * (self.rss / n).max(1e-300).ln() + self.columns.len() as f64 * n.ln()
+    }
+
+    /// Coefficient of a column.
+    pub fn coef_of(&self, col: usize) -> Option<(f64, f64)> {
+        self.columns
+            .iter()
+            .position(|&c| c == col)
+            .map(|i| (self.coef[i], self.se[i]))
+    }
+
+    /// Residuals on rows.
+    pub fn residuals(&self, rows: &[WeakRow]) -> Vec<f64> {
+        rows.iter()
+            .map(|r| {
+                r.target
+                    - self
+                        .columns
+                        .iter()
+                        .zip(&self.coef)
+                        .map(|(&c, b)| r.x[c] * b)
+                        .sum::<f64>()
+            })
+            .collect()
+    }
+}
+
+/// OLS of the target on `columns` (columns are scaled for conditioning).
+pub fn ols(rows: &[WeakRow], columns: &[usize]) -> Option<Ols> {
+    let p = columns.len();
+    let n = rows.len();
+    if n <= p + 2 {
+        return None;
+    }
+    let scale: Vec<f64> = columns
+        .iter()
+        .map(|&c| {
+            (rows.iter().map(|r| r.x[c] * r.x[c]).sum::<f64>() / n as f64)
+                .sqrt()
+                .max(1e-300)
+        })
+        .collect();
+    let mut ata = vec![0.0; p * p];
+    let mut atb = vec![0.0; p];
+    for r in rows {
+        for i in 0..p {
+            let xi = r.x[columns[i]] / scale[i];
+            atb[i] += xi * r.target;
+            for j in 0..p {
+                ata[i * p + j] += xi * r.x[columns[j]] / scale[j];
+            }
+        }
+    }
+    let beta = if p == 0 {
+        Vec::new()
+    } else {
+        solve(&ata, &atb, p)?
+    };
+    let mut rss = 0.0;
+    for r in rows {
+        let fit: f64 = (0..p).map(|i| r.x[columns[i]] / scale[i] * beta[i]).sum();
+        rss += (r.target - fit).powi(2);
+    }
+    let s2 = rss / (n - p) as f64;
+    let inv = if p == 0 {
+        Vec::new()
+    } else {
+        inverse(&ata, p)?
+    };
+    Some(Ols {
+        columns: columns.to_vec(),
+        coef: (0..p).map(|i| beta[i] / scale[i]).collect(),
+        se: (0..p)
+            .map(|i| (inv[i * p + i] * s2).max(0.0).sqrt() / scale[i])
+            .collect(),
+        rss,
+        n,
+    })
+}
+
+/// One screened candidate.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Screened {
+    pub candidate: Candidate,
+    pub delta_bic: f64,
+    pub fit: Ols,
+}
+
+/// Columns of the base with a candidate applied.
+pub fn with_candidate(base_cols: &[usize], c: &Candidate) -> Vec<usize> {
+    let mut cols: Vec<usize> = base_cols
+        .iter()
+        .copied()
+        .filter(|&x| Some(x) != c.replaces)
+        .collect();
+    for &a in &c.add {
+        if !cols.contains(&a) {
+            cols.push(a);
+        }
+    }
+    cols
+}
+
+/// ΔBIC of every candidate against `current` columns.
+pub fn screen(rows: &[WeakRow], current: &[usize], cands: &[Candidate]) -> Vec<Screened> {
+    let Some(base) = ols(rows, current) else {
+        return Vec::new();
+    };
+    let b0 = base.bic();
+    let mut out: Vec<Screened> = cands
+        .iter()
+        .filter_map(|c| {
+            let cols = with_candidate(current, c);
+            let fit = ols(rows, &cols)?;
+            Some(Screened {
+                candidate: c.clone(),
+                delta_bic: fit.bic() - b0,
+                fit,
+            })
+        })
+        .collect();
+    out.sort_by(|a, b| a.delta_bic.total_cmp(&b.delta_bic));
+    out
+}
+
+/// Forward stepwise selection: the sequence of candidates that each lower BIC by more than
+/// `threshold` given the ones before (at most `max_effects`).
+pub fn stepwise(
+    rows: &[WeakRow],
+    base: Base,
+    threshold: f64,
+    max_effects: usize,
+) -> (Vec<Screened>, Vec<Screened>) {
+    let mut current = base.columns();
+    let mut chosen: Vec<Screened> = Vec::new();
+    let mut first_round = Vec::new();
+    let mut pool = candidates(base);
+    for round in 0..max_effects {
+        let ranked = screen(rows, &current, &pool);
+        if round == 0 {
+            first_round = ranked.clone();
+        }
+        let Some(best) = ranked.first() else { break };
+        if best.delta_bic >= threshold {
+            break;
+        }
+        current = with_candidate(&current, &best.candidate);
+        let name = best.candidate.effect.clone();
+        pool.retain(|c| c.effect != name);
+        chosen.push(best.clone());
+    }
+    (chosen, first_round)
+}

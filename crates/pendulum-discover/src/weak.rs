@@ -1,0 +1,356 @@
+//! The equation-error view in weak form: the torque the model fails to explain, at each instant,
+//! without differentiating noise twice.
+//!
+//! Every term of the equation of motion is integrated against one smooth test function
+//! K(t − t_k) = (1 − s²)⁴, s = (t − t_k)/h; the θ̈ term becomes ∫K''θ (integration by parts), so
+//! only θ and a first derivative (local cubic fit) are ever used. Windows are spaced by their
+//! full width 2h, so rows are close to independent (the information criterion counts them).
+//! Extra inertia scales θ̈ itself; regressing on the measured ∫K''θ would put its noise on both
+//! sides (errors in variables: a spurious negative inertia). (1 + j)θ̈ = −G − D gives
+//! jθ̈ ≈ −j(G + D) ≈ −jG to first order, so the regressor is −∫K(1 + A_y) sin θ, free of noise.
+//! Windows where the pendulum sticks (the friction force is then static and unknown), gaps, and
+//! the shaker's spin-up are left out.
+
+use pendulum_model::excitation::{crank_f1, crank_f2};
+use pendulum_process::{Alignment, RunData};
+use serde::{Deserialize, Serialize};
+
+/// Regressors (each ∫K·term over a window), in dimensionless units of θ̈.
+pub const TERMS: [&str; 16] = [
+    "lin",       // θ̇
+    "quad",      // θ̇|θ̇|
+    "coul_ref",  // |θ̇² + cos θ| sgn θ̇
+    "coul_base", // |θ̇² + (1 + A_y) cos θ| sgn θ̇
+    "const",     // sgn θ̇
+    "pos1_sin",
+    "pos1_cos",
+    "pos2_sin",
+    "pos2_cos",
+    "pos3_sin",
+    "pos3_cos",
+    "pos4_sin",
+    "pos4_cos",
+    "horiz",   // A_y cos θ
+    "inertia", // −(1 + A_y) sin θ: the model's θ̈, a noise-free stand-in for the measured θ̈
+    "offset",  // (1 + A_y) cos θ
+];
+
+/// Index of the accel-delay regressor in [`WeakRow::x`] (after [`TERMS`]).
+pub const DELAY: usize = TERMS.len();
+
+/// One window.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct WeakRow {
+    pub run: usize,
+    /// Window centre, s from the aligned t = 0 (negative: the free segment).
+    pub tau_s: f64,
+    /// θ, rad; θ̇, rad/s; forcing phase (rad, NaN in the free segment) at the centre.
+    pub theta: f64,
+    pub theta_dot_rad_s: f64,
+    pub phase: f64,
+    /// Measured vertical and horizontal accelerations at the centre, m/s² (z without g).
+    pub a_y_meas: f64,
+    pub a_x_meas: f64,
+    /// Target −∫K(θ̈ + (1 + A_y) sin θ): what damping and the effects must explain.
+    pub target: f64,
+    /// Regressors: [`TERMS`] then the accel-delay term Ȧ_y sin θ.
+    pub x: Vec<f64>,
+}
+
+/// Weak-form settings.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct WeakConfig {
+    /// Test-function half-width, s.
+    pub half_width_s: f64,
+    /// Half-width of the local cubic giving θ̇, s.
+    pub deriv_half_width_s: f64,
+    /// Longest forced stretch used per run after t = 0, s.
+    pub forced_s: f64,
+    /// Dimensionless |θ̇| below which a sample counts as stuck.
+    pub stuck_theta_dot: f64,
+}
+
+impl Default for WeakConfig {
+    fn default() -> Self {
+        Self {
+            half_width_s: 0.08,
+            deriv_half_width_s: 0.02,
+            forced_s: 60.0,
+            stuck_theta_dot: 0.02,
+        }
+    }
+}
+
+fn kernel(s: f64) -> (f64, f64) {
+    // K = (1 − s²)⁴ and d²K/ds² = −8(1 − s²)³ + 48 s²(1 − s²)².
+    let u = 1.0 - s * s;
+    if u <= 0.0 {
+        return (0.0, 0.0);
+    }
+    (u.powi(4), -8.0 * u.powi(3) + 48.0 * s * s * u * u)
+}
+
+/// Uniform resampling of θ at the encoder's median rate; `None` entries mark gaps.
+fn resample(t: &[f64], y: &[f64], t_from: f64, t_to: f64, dt: f64) -> Vec<Option<f64>> {
+    let n = ((t_to - t_from) / dt).floor().max(0.0) as usize + 1;
+    let mut out = Vec::with_capacity(n);
+    let mut j = 0;
+    for i in 0..n {
+        let x = t_from + i as f64 * dt;
+        while j + 1 < t.len() && t[j + 1] < x {
+            j += 1;
+        }
+        if j + 1 >= t.len() || t[j] > x {
+            out.push(None);
+            continue;
+        }
+        let (t0, t1) = (t[j], t[j + 1]);
+        if t1 - t0 > 3.5 * dt {
+            out.push(None);
+            continue;
+        }
+        let w = (x - t0) / (t1 - t0);
+        out.push(Some(y[j] + w * (y[j + 1] - y[j])));
+    }
+    out
+}
+
+/// Builds the weak-form rows of one run: the free segment (no base motion) and the forced part
+/// from t = 0 (the crank-rod model of the alignment drives A_y).
+pub fn weak_rows(run_idx: usize, run: &RunData, al: &Alignment, cfg: &WeakConfig) -> Vec<WeakRow> {
+    let (t, th) = (&run.enc_t_s, &run.theta_rad);
+    if t.len() < 100 {
+        return Vec::new();
+    }
+    let mut dts: Vec<f64> = t
+        .windows(2)
+        .map(|w| w[1] - w[0])
+        .filter(|d| *d > 0.0)
+        .collect();
+    dts.sort_by(f64::total_cmp);
+    let dt = dts[dts.len() / 2];
+    let w0 = run.rig.omega0_rad_s();
+    let lambda = run.rig.crank_r_m / run.rig.rod_l_m;
+    let omega = 2.0 * std::f64::consts::PI * al.omega_hz / w0;
+    let r_over_l = run.rig.crank_r_m / run.rig.l_m;
+    // Forcing in the aligned dimensionless time (φ = ωt), and its rate.
+    let forcing = |tau: f64| -> (f64, f64, f64) {
+        let tt = tau * w0;
+        let phi = omega * tt;
+        let ay = r_over_l * omega * omega * crank_f2(phi, lambda);
+        let h = 1e-4;
+        let d = r_over_l
+            * omega
+            * omega
+            * (crank_f2(phi + omega * h, lambda) - crank_f2(phi - omega * h, lambda))
+            / (2.0 * h);
+        let _ = crank_f1;
+        (ay, d, phi.rem_euclid(2.0 * std::f64::consts::PI))
+    };
+    let mut rows = Vec::new();
+    let spans = [
+        (
+            al.free_segment_s.0 - al.t0_s,
+            al.free_segment_s.1 - al.t0_s,
+            false,
+        ),
+        (0.0, (t[t.len() - 1] - al.t0_s).min(cfg.forced_s), true),
+    ];
+    let hw = cfg.half_width_s;
+    let hd = ((cfg.deriv_half_width_s / dt).round() as usize).max(2);
+    for (a, b, forced) in spans {
+        if b - a < 4.0 * hw {
+            continue;
+        }
+        let grid = resample(t, th, al.t0_s + a, al.t0_s + b, dt);
+        let n = grid.len();
+        // θ̇ (rad/s) by a local cubic: least-squares slope over ±hd samples.
+        let mut thd = vec![None; n];
+        for i in hd..n.saturating_sub(hd) {
+            let win: Option<Vec<f64>> = grid[i - hd..=i + hd].iter().copied().collect();
+            let Some(win) = win else { continue };
+            // Cubic fit on x = (j − hd)/hd, slope at 0 = b1/hd/dt; closed form via normal equations.
+            let rows_x: Vec<Vec<f64>> = (0..win.len())
+                .map(|j| {
+                    let x = (j as f64 - hd as f64) / hd as f64;
+                    vec![1.0, x, x * x, x * x * x]
+                })
+                .collect();
+            if let Some((c, _, _)) = pendulum_process::linalg::lstsq(&rows_x, &win) {
+                thd[i] = Some(c[1] / (hd as f64 * dt));
+            }
+        }
+        let half = (hw / dt).round() as usize;
+        let h_dimless = hw * w0;
+        let mut c = half + hd;
+        while c + half + hd < n {
+            let range = c - half..=c + half;
+            let ok = range.clone().all(|i| grid[i].is_some() && thd[i].is_some());
+            if !ok {
+                c += 2 * half;
+                continue;
+            }
+            let stuck = range
+                .clone()
+                .filter(|&i| (thd[i].unwrap_or(0.0) / w0).abs() < cfg.stuck_theta_dot)
+                .count();
+            if stuck * 10 > 2 * half + 1 {
+                c += 2 * half;
+                continue;
+            }
+            let mut target = 0.0;
+            let mut x = vec![0.0; TERMS.len() + 1];
+            let th_c = grid[c].unwrap_or(0.0);
+            let dtt = dt * w0; // dimensionless step
+            for i in range.clone() {
+                let s = (i as f64 - c as f64) / half as f64;
+                let (k, k2) = kernel(s);
+                let wgt = if i == c - half || i == c + half {
+                    0.5
+                } else {
+                    1.0
+                };
+                let th_i = grid[i].unwrap_or(0.0);
+                let w = thd[i].unwrap_or(0.0) / w0;
+                let tau = a + i as f64 * dt;
+                let (ay, ay_dot, _) = if forced {
+                    forcing(tau)
+                } else {
+                    (0.0, 0.0, 0.0)
+                };
+                let (sn, cs) = th_i.sin_cos();
+                let sg = if w > 0.0 {
+                    1.0
+                } else if w < 0.0 {
+                    -1.0
+                } else {
+                    0.0
+                };
+                let kk = k * wgt * dtt;
+                // ∫K''θ dt with d²/dt² = (1/h²) d²/ds², about the window's centre value: ∫K'' = 0
+                // exactly, but not its discrete sum, which would multiply a rotating run's
+                // unwrapped angle (tens of rad) into the result.
+                let theta_dd = k2 / (h_dimless * h_dimless) * (th_i - th_c) * wgt * dtt;
+                target -= theta_dd + kk * (1.0 + ay) * sn;
+                let terms = [
+                    w,
+                    w * w.abs(),
+                    (w * w + cs).abs() * sg,
+                    (w * w + (1.0 + ay) * cs).abs() * sg,
+                    sg,
+                    th_i.sin(),
+                    th_i.cos(),
+                    (2.0 * th_i).sin(),
+                    (2.0 * th_i).cos(),
+                    (3.0 * th_i).sin(),
+                    (3.0 * th_i).cos(),
+                    (4.0 * th_i).sin(),
+                    (4.0 * th_i).cos(),
+                    ay * cs,
+                    -(1.0 + ay) * sn,
+                    (1.0 + ay) * cs,
+                    ay_dot * sn,
+                ];
+                for (xi, v) in x.iter_mut().zip(terms) {
+                    *xi += kk * v;
+                }
+            }
+            let tau_c = a + c as f64 * dt;
+            let (_, _, phase) = if forced {
+                forcing(tau_c)
+            } else {
+                (0.0, 0.0, f64::NAN)
+            };
+            let ta = al.t0_s + tau_c;
+            let ia = run
+                .acc_t_s
+                .partition_point(|&v| v < ta)
+                .min(run.acc_t_s.len().saturating_sub(1));
+            rows.push(WeakRow {
+                run: run_idx,
+                tau_s: tau_c,
+                theta: grid[c].unwrap_or(f64::NAN),
+                theta_dot_rad_s: thd[c].unwrap_or(f64::NAN),
+                phase: if forced { phase } else { f64::NAN },
+                a_y_meas: run
+                    .az_m_s2
+                    .get(ia)
+                    .map_or(f64::NAN, |v| v - al.az_offset_m_s2),
+                a_x_meas: run.ax_m_s2.get(ia).copied().unwrap_or(f64::NAN),
+                target,
+                x,
+            });
+            c += 2 * half;
+        }
+    }
+    rows
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use pendulum_model::{simulate, Dimensionless, Excitation, Model, SimOptions};
+    use pendulum_process::{RigParams, Role};
+
+    /// On an exact free decay with viscous + bearing friction, the weak-form regression returns
+    /// β and M (an independent check of the integration by parts and the scalings).
+    #[test]
+    fn weak_form_recovers_free_decay_damping() {
+        let rig = RigParams {
+            m_kg: 1.46,
+            l_m: 0.265,
+            crank_r_m: 0.0725,
+            rod_l_m: 0.575,
+            r_b_m: 0.01225,
+            omega_hz: Some(1.5),
+            g_m_s2: 9.81,
+        };
+        let w0 = rig.omega0_rad_s();
+        let mut d = Dimensionless::conservative();
+        d.beta = 0.05;
+        d.m_coulomb = 0.007;
+        let m = Model::with_excitation(d, Excitation::None);
+        let dt = 0.001 * w0;
+        let tr = simulate(
+            &m,
+            &SimOptions::with_tol(1e-10),
+            [2.0, 0.0],
+            0.0,
+            20.0 * w0,
+            dt,
+        )
+        .unwrap();
+        let run = RunData {
+            id: "x".into(),
+            role: Role::Identify,
+            rig,
+            enc_t_s: tr.t.iter().map(|t| t / w0).collect(),
+            theta_rad: tr.theta.clone(),
+            acc_t_s: vec![],
+            az_m_s2: vec![],
+            ax_m_s2: vec![],
+        };
+        let al = Alignment {
+            shaker_start_s: 30.0,
+            free_segment_s: (0.0, 19.9),
+            t0_s: 25.0,
+            t0_sigma_s: 0.0,
+            omega_hz: 1.5,
+            omega_sigma_hz: 0.0,
+            accel_gain: 1.0,
+            az_offset_m_s2: 9.81,
+            residual_rms_m_s2: 0.0,
+            fit_window_s: (0.0, 0.0),
+        };
+        let rows = weak_rows(0, &run, &al, &WeakConfig::default());
+        assert!(rows.len() > 50, "{} rows", rows.len());
+        let fit = crate::screen::ols(&rows, &[0, 2, 14]).unwrap();
+        let (b, _) = fit.coef_of(0).unwrap();
+        let (mm, _) = fit.coef_of(2).unwrap();
+        let (j, _) = fit.coef_of(14).unwrap();
+        assert!((b - 0.05).abs() < 0.002, "beta {b}");
+        assert!((mm - 0.007).abs() < 0.0005, "M {mm}");
+        assert!(j.abs() < 0.01, "j {j}");
+    }
+}

@@ -1,0 +1,439 @@
+//! `pendulum discover`: fit the base model, show what it gets wrong, name the cause, extend the
+//! model and measure the gain on held-out runs; tables, plots and `report.md`.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use pendulum_discover::{discover, Base, DiscoverConfig, Discovery};
+use pendulum_plot::{Figure, Panel, Series, SeriesStyle};
+use pendulum_process::pipeline::{Context, PipelineConfig, StageConfig};
+use pendulum_process::Role;
+use pendulum_report::{Column, ColumnData};
+use serde::{Deserialize, Serialize};
+
+use crate::outputs::write_outputs;
+use crate::runs::load_runs;
+use crate::JobError;
+
+/// The built-in discover pipeline (`pipelines/discover.toml`).
+pub const DISCOVER_PIPELINE: &str = include_str!("../../../pipelines/discover.toml");
+
+/// A discover pipeline file: the identify stages plus a `[discover]` table.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DiscoverPipeline {
+    pub name: String,
+    #[serde(rename = "stage")]
+    pub stages: Vec<StageConfig>,
+    #[serde(default)]
+    pub discover: DiscoverConfig,
+}
+
+/// What to discover.
+#[derive(Debug, Clone)]
+pub struct DiscoverJob {
+    pub input: PathBuf,
+    pub out: PathBuf,
+    pub base: Base,
+    pub pipeline: Option<PathBuf>,
+    pub generations: Option<u64>,
+    pub seed: Option<u64>,
+    pub progress: bool,
+}
+
+/// What discover wrote and found.
+#[derive(Debug, Clone)]
+pub struct DiscoverSummary {
+    pub out_dir: PathBuf,
+    pub report: PathBuf,
+    pub discovery: Discovery,
+    pub text: String,
+}
+
+impl std::fmt::Display for DiscoverSummary {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.text)
+    }
+}
+
+fn load(path: Option<&Path>) -> Result<DiscoverPipeline, JobError> {
+    let (text, src) = match path {
+        Some(p) => (
+            std::fs::read_to_string(p).map_err(|source| JobError::Io {
+                path: p.to_path_buf(),
+                source,
+            })?,
+            p.display().to_string(),
+        ),
+        None => (DISCOVER_PIPELINE.to_string(), "<built-in discover>".into()),
+    };
+    toml::from_str(&text)
+        .map_err(|e| JobError::Invalid(format!("{src}: pipeline: {}", e.message())))
+}
+
+/// The diagnosis as a short table.
+pub fn diagnosis_table(d: &Discovery) -> String {
+    let mut t = String::new();
+    let _ = writeln!(
+        t,
+        "{:<24} {:>8} {:>12} {:>24} {:<6} {:>9} {:>9}",
+        "effect", "accepted", "estimate", "95 % interval", "unit", "ΔBIC", "gain"
+    );
+    for r in &d.rows {
+        let _ = writeln!(
+            t,
+            "{:<24} {:>8} {:>12.4e} [{:>10.3e}, {:>10.3e}] {:<6} {:>9.1} {:>8.1}%",
+            r.effect,
+            if r.accepted { "YES" } else { "no" },
+            r.estimate,
+            r.ci_low,
+            r.ci_high,
+            r.unit,
+            r.delta_bic,
+            100.0 * r.heldout_gain
+        );
+    }
+    t
+}
+
+pub fn run(job: &DiscoverJob) -> Result<DiscoverSummary, JobError> {
+    let started = Instant::now();
+    let mut pipe = load(job.pipeline.as_deref())?;
+    for s in &mut pipe.stages {
+        if let StageConfig::Fit(f) = s {
+            f.model = job.base.name().into();
+            f.effects.clear();
+            if let Some(g) = job.generations {
+                f.max_generations = g;
+            }
+            if let Some(seed) = job.seed {
+                f.seed = seed;
+            }
+        }
+    }
+    let pipeline_json = serde_json::to_string(&pipe).unwrap_or_default();
+    let stages = PipelineConfig {
+        name: pipe.name.clone(),
+        stages: pipe
+            .stages
+            .iter()
+            .filter(|s| !matches!(s, StageConfig::Validate(_)))
+            .cloned()
+            .collect(),
+    };
+    let runs = load_runs(&job.input)?;
+    for role in [Role::Identify, Role::Validate] {
+        if !runs.iter().any(|r| r.role == role) {
+            return Err(JobError::Invalid(format!(
+                "{}: no run has role = \"{}\": discover fits on identify runs and measures the gain on validate runs",
+                job.input.display(),
+                role.as_str()
+            )));
+        }
+    }
+    let mut ctx = Context::new(runs);
+    let max_gen = stages.stages.iter().find_map(|s| match s {
+        StageConfig::Fit(f) => Some(f.max_generations),
+        _ => None,
+    });
+    let bar = if job.progress {
+        let (bar, f) = crate::identify::generation_bar(max_gen.unwrap_or(0));
+        ctx.progress = Some(f);
+        Some(bar)
+    } else {
+        None
+    };
+    let res = stages.run(&mut ctx);
+    if let Some(b) = bar {
+        b.finish_and_clear();
+    }
+    res?;
+    let d = discover(&ctx, job.base, &pipe.discover)?;
+
+    // Tables shared with identify: params/residuals/... for the base and the extended model.
+    ctx.validations
+        .push((d.base.spec.name.clone(), d.validation_base.clone()));
+    if let Some(ext) = &d.extended {
+        ctx.fits.push(ext.clone());
+        ctx.validations
+            .push((ext.spec.name.clone(), d.validation_final.clone()));
+    }
+    let out = &job.out;
+    let mut summary = write_outputs(
+        &ctx,
+        out,
+        &pipeline_json,
+        "pendulum discover",
+        started.elapsed().as_secs_f64(),
+    )?;
+    let opts = pendulum_report::TableOptions::new()
+        .meta("command", "pendulum discover")
+        .meta("pipeline", pipeline_json.clone())
+        .meta("base", job.base.name());
+
+    // diagnosis.parquet
+    let f = |v: Vec<f64>, name: &str, unit: &str| Column::f64(name, unit, v);
+    let rows = &d.rows;
+    opts.write(
+        &out.join("diagnosis.parquet"),
+        &[
+            Column::new(
+                "effect",
+                ColumnData::Str(rows.iter().map(|r| r.effect.clone()).collect()),
+            ),
+            Column::new(
+                "accepted",
+                ColumnData::Bool(rows.iter().map(|r| r.accepted).collect()),
+            ),
+            f(
+                rows.iter().map(|r| r.estimate).collect(),
+                "estimate",
+                "see column unit",
+            ),
+            f(
+                rows.iter().map(|r| r.ci_low).collect(),
+                "ci_low",
+                "see column unit",
+            ),
+            f(
+                rows.iter().map(|r| r.ci_high).collect(),
+                "ci_high",
+                "see column unit",
+            ),
+            Column::new(
+                "unit",
+                ColumnData::Str(rows.iter().map(|r| r.unit.clone()).collect()),
+            ),
+            f(rows.iter().map(|r| r.delta_bic).collect(), "delta_bic", "1"),
+            f(
+                rows.iter().map(|r| r.heldout_gain).collect(),
+                "heldout_gain",
+                "1 (fraction)",
+            ),
+            f(
+                rows.iter().map(|r| r.screen_estimate).collect(),
+                "screen_estimate",
+                "see column unit",
+            ),
+            f(
+                rows.iter().map(|r| r.e_validate_before).collect(),
+                "e_validate_before",
+                "rad",
+            ),
+            f(
+                rows.iter().map(|r| r.e_validate_after).collect(),
+                "e_validate_after",
+                "rad",
+            ),
+            Column::new(
+                "note",
+                ColumnData::Str(rows.iter().map(|r| r.note.clone()).collect()),
+            ),
+        ],
+    )?;
+    // signatures.parquet: one row per equation-error window.
+    let w = &d.weak;
+    opts.write(
+        &out.join("signatures.parquet"),
+        &[
+            Column::new(
+                "run_id",
+                ColumnData::Str(w.iter().map(|r| d.weak_runs[r.run].0.clone()).collect()),
+            ),
+            Column::new(
+                "role",
+                ColumnData::Str(
+                    w.iter()
+                        .map(|r| d.weak_runs[r.run].1.as_str().to_string())
+                        .collect(),
+                ),
+            ),
+            Column::new(
+                "segment",
+                ColumnData::Str(
+                    w.iter()
+                        .map(|r| {
+                            if r.phase.is_nan() {
+                                "free".to_string()
+                            } else {
+                                "forced".to_string()
+                            }
+                        })
+                        .collect(),
+                ),
+            ),
+            f(w.iter().map(|r| r.tau_s).collect(), "tau_s", "s"),
+            f(w.iter().map(|r| r.theta).collect(), "theta", "rad"),
+            f(
+                w.iter().map(|r| r.theta_dot_rad_s).collect(),
+                "theta_dot",
+                "rad/s",
+            ),
+            f(w.iter().map(|r| r.phase).collect(), "forcing_phase", "rad"),
+            f(
+                w.iter().map(|r| r.a_y_meas).collect(),
+                "a_vertical_meas",
+                "m/s²",
+            ),
+            f(
+                w.iter().map(|r| r.a_x_meas).collect(),
+                "a_horizontal_meas",
+                "m/s²",
+            ),
+            f(
+                d.residual_base.clone(),
+                "torque_unexplained_base",
+                "1 (per m·g·l, test-function weighted)",
+            ),
+            f(
+                d.residual_final.clone(),
+                "torque_unexplained_final",
+                "1 (per m·g·l, test-function weighted)",
+            ),
+        ],
+    )?;
+    summary.tables.push(out.join("diagnosis.parquet"));
+    summary.tables.push(out.join("signatures.parquet"));
+    let sig_png = out.join("signatures.png");
+    signature_plot(&sig_png, &d)?;
+    summary.plots.push(sig_png.clone());
+
+    let table = diagnosis_table(&d);
+    let report = out.join("report.md");
+    write_report(&report, job, &d, &table, &summary.plots, &ctx)?;
+    let mut text = summary.text.clone();
+    let _ = writeln!(text, "\nDiagnosis (base model: {}):", job.base.name());
+    text.push_str(&table);
+    if let Some(u) = &d.unexplained {
+        let _ = writeln!(text, "unexplained: {u}");
+    }
+    let (b, a) = (e(&d.validation_base), e(&d.validation_final));
+    let _ = writeln!(
+        text,
+        "held-out E_θ (validate runs): base {b:.4} → final {a:.4} ({:+.1} %); report: {}",
+        -100.0 * (1.0 - a / b.max(1e-12)),
+        report.display()
+    );
+    Ok(DiscoverSummary {
+        out_dir: out.clone(),
+        report,
+        discovery: d,
+        text,
+    })
+}
+
+fn e(v: &[pendulum_process::identify::RunFit]) -> f64 {
+    v.iter().map(|r| r.e_theta).sum()
+}
+
+fn signature_plot(path: &Path, d: &Discovery) -> Result<(), JobError> {
+    let idm: Vec<usize> = (0..d.weak.len())
+        .filter(|&i| d.weak_runs[d.weak[i].run].1 == Role::Identify)
+        .collect();
+    let pts = |key: &dyn Fn(usize) -> f64, res: &[f64], label: &str, color: usize| Series {
+        label: label.into(),
+        x: idm.iter().map(|&i| key(i)).collect(),
+        y: idm.iter().map(|&i| res[i]).collect(),
+        style: SeriesStyle::Points,
+        color: Some(color),
+    };
+    let panel = |title: &str, xl: &str, key: &dyn Fn(usize) -> f64| Panel {
+        title: title.into(),
+        x_label: xl.into(),
+        y_label: "unexplained torque / (m·g·l)".into(),
+        series: vec![
+            pts(key, &d.residual_base, "base model", 1),
+            pts(key, &d.residual_final, "final model", 0),
+        ],
+        ..Panel::default()
+    };
+    let fig = Figure {
+        title:
+            "Where the model departs from the rig: weak-form equation error on the identify runs"
+                .into(),
+        panels: vec![
+            panel(
+                "against angular velocity (dry friction: a step at dθ/dt = 0)",
+                "dθ/dt (rad/s)",
+                &|i| d.weak[i].theta_dot_rad_s,
+            ),
+            panel(
+                "against angle (position torque: a sinusoid in θ)",
+                "θ mod 2π (rad)",
+                &|i| d.weak[i].theta.rem_euclid(2.0 * std::f64::consts::PI),
+            ),
+            panel(
+                "against forcing phase (excitation errors)",
+                "crank phase (rad)",
+                &|i| d.weak[i].phase,
+            ),
+        ],
+        width: 1200,
+        height: 1200,
+    };
+    fig.save_png(path)?;
+    Ok(())
+}
+
+fn write_report(
+    path: &Path,
+    job: &DiscoverJob,
+    d: &Discovery,
+    table: &str,
+    plots: &[PathBuf],
+    ctx: &Context,
+) -> Result<(), JobError> {
+    let mut r = String::new();
+    let _ = writeln!(r, "# What the {} model gets wrong\n", job.base.name());
+    let _ = writeln!(
+        r,
+        "Campaign: `{}` ({} runs: {} identify, {} validate).\n",
+        job.input.display(),
+        ctx.runs.len(),
+        ctx.runs.iter().filter(|x| x.role == Role::Identify).count(),
+        ctx.runs.iter().filter(|x| x.role == Role::Validate).count()
+    );
+    let _ = writeln!(r, "## Base model\n");
+    for (p, v) in d.base.spec.params.iter().zip(&d.base.params) {
+        let _ = writeln!(r, "- {} = {:.5} {}", p.name(), v, p.unit());
+    }
+    let _ = writeln!(r, "\n## Diagnosis\n\nOne row per catalogue candidate screened (ΔBIC of the weak-form equation error on the identify runs); the best are refitted on the trajectories and accepted only if their 95 % interval excludes zero and the error on the validate runs falls by more than the validation's own noise.\n\n```\n{table}```\n");
+    match &d.unexplained {
+        Some(u) => {
+            let _ = writeln!(r, "**Unexplained:** {u}.\n");
+        }
+        None => {
+            let _ = writeln!(r, "No structure is left in the equation error against dθ/dt, θ or the forcing phase (p ≥ 1e-6).\n");
+        }
+    }
+    if let Some(ext) = &d.extended {
+        let _ = writeln!(r, "## Extended model `{}`\n", ext.spec.name);
+        for (p, v) in ext.spec.params.iter().zip(&ext.params) {
+            let _ = writeln!(r, "- {} = {:.5} {}", p.name(), v, p.unit());
+        }
+    }
+    let _ = writeln!(r, "\n## Held-out runs\n\n| run | E_θ base | E_θ final | steady measured | base | final |\n|---|---|---|---|---|---|");
+    for (b, f) in d.validation_base.iter().zip(&d.validation_final) {
+        let _ = writeln!(
+            r,
+            "| {} | {:.4} | {:.4} | {} | {} | {} |",
+            b.id,
+            b.e_theta,
+            f.e_theta,
+            b.measured,
+            b.simulated.map_or("-".into(), |s| s.to_string()),
+            f.simulated.map_or("-".into(), |s| s.to_string())
+        );
+    }
+    let _ = writeln!(r, "\n## Figures\n");
+    for p in plots {
+        if let Some(name) = p.file_name() {
+            let _ = writeln!(r, "![{0}]({0})\n", name.to_string_lossy());
+        }
+    }
+    std::fs::write(path, r).map_err(|source| JobError::Io {
+        path: path.to_path_buf(),
+        source,
+    })
+}
