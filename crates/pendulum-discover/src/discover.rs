@@ -32,8 +32,10 @@ pub struct DiscoverConfig {
     pub screen_threshold: f64,
     /// Most effects added on top of the base.
     pub max_effects: usize,
-    /// Smallest held-out gain that can count.
+    /// Trajectory E_θ on the validate runs may not rise by more than max(this, 3 × noise).
     pub gain_min: f64,
+    /// Smallest fall of the validate runs' equation error (coefficients from the identify runs).
+    pub eq_gain_min: f64,
     pub weak: WeakConfig,
     /// Objective evaluations of each confirming refit (Nelder–Mead).
     pub refit_evals: usize,
@@ -46,6 +48,7 @@ impl Default for DiscoverConfig {
             screen_threshold: -10.0,
             max_effects: 2,
             gain_min: 0.02,
+            eq_gain_min: 0.05,
             weak: WeakConfig::default(),
             refit_evals: 300,
             validate: ValidateConfig {
@@ -366,6 +369,14 @@ pub fn discover(
         .filter(|r| weak_runs[r.run].1 == Role::Identify)
         .cloned()
         .collect();
+    let val_rows: Vec<WeakRow> = weak
+        .iter()
+        .filter(|r| weak_runs[r.run].1 == Role::Validate)
+        .cloned()
+        .collect();
+    // Held-out equation error: coefficients fitted on the identify runs, scored on the validate runs.
+    let rss_val =
+        |fit: &crate::screen::Ols| -> f64 { fit.residuals(&val_rows).iter().map(|e| e * e).sum() };
     let base_ols = ols(&id_rows, &base.columns()).ok_or_else(|| ProcessError::Run {
         run: "(identify runs)".into(),
         reason: format!(
@@ -423,9 +434,17 @@ pub fn discover(
         let val = validate(&val_runs, &spec, &x, &cfg.validate)?;
         let (before, after) = (e_total(&current_val), e_total(&val));
         let gain = 1.0 - after / before.max(1e-12);
+        let eq_gain = match ols(&id_rows, &current_cols) {
+            Some(f0) => 1.0 - rss_val(&fit) / rss_val(&f0).max(1e-300),
+            None => f64::NAN,
+        };
         let ci = (est - 1.96 * se, est + 1.96 * se);
         let excludes_zero = ci.0 > 0.0 || ci.1 < 0.0;
-        let accepted = excludes_zero && sc.delta_bic < cfg.screen_threshold && gain > gain_needed;
+        let accepted = excludes_zero
+            && sc.delta_bic < cfg.screen_threshold
+            && eq_gain > cfg.eq_gain_min
+            && gain > -gain_needed
+            && (gain > gain_needed || eq_gain > 2.0 * cfg.eq_gain_min);
         // The refitted value of the effect's first parameter (μ for bearing_load_base_accel).
         let refit_est = match c.effect.as_str() {
             "bearing_load_base_accel" => spec

@@ -47,7 +47,10 @@ pub struct DiscoverJob {
 pub struct DiscoverSummary {
     pub out_dir: PathBuf,
     pub report: PathBuf,
+    /// The forced-run discovery (empty rows for free-decay campaigns).
     pub discovery: Discovery,
+    /// Per-run free-decay diagnoses (campaigns without a shaker).
+    pub decays: Vec<(String, pendulum_explain::DecayDiagnosis)>,
     pub text: String,
 }
 
@@ -123,6 +126,9 @@ pub fn run(job: &DiscoverJob) -> Result<DiscoverSummary, JobError> {
             .collect(),
     };
     let runs = load_runs(&job.input)?;
+    if !runs.is_empty() && runs.iter().all(|r| r.rig.omega_hz.is_none()) {
+        return free_decays(job, &runs, &pipeline_json);
+    }
     for role in [Role::Identify, Role::Validate] {
         if !runs.iter().any(|r| r.role == role) {
             return Err(JobError::Invalid(format!(
@@ -319,6 +325,148 @@ pub fn run(job: &DiscoverJob) -> Result<DiscoverSummary, JobError> {
         out_dir: out.clone(),
         report,
         discovery: d,
+        decays: Vec::new(),
+        text,
+    })
+}
+
+/// Campaigns without a shaker: every run is a free decay, analysed in identifiable ratios
+/// (`pendulum_explain::decay`), each fitted on its first half and scored on its second.
+fn free_decays(
+    job: &DiscoverJob,
+    runs: &[pendulum_process::RunData],
+    pipeline_json: &str,
+) -> Result<DiscoverSummary, JobError> {
+    use pendulum_explain::{diagnose_decay, DecayOptions, KnownRig, Term};
+    let out = &job.out;
+    std::fs::create_dir_all(out).map_err(|source| JobError::Io {
+        path: out.clone(),
+        source,
+    })?;
+    let mut decays = Vec::new();
+    let mut text = String::new();
+    let mut report = format!(
+        "# Free decays: what the {} model misses\n\nCampaign `{}`: {} free-decay runs (no shaker). Each run is fitted on its first half of swings and scored on the second (E_θ = Σ|θ_meas − θ_sim|, restarting at measured turning points).\n\n",
+        job.base.name(),
+        job.input.display(),
+        runs.len()
+    );
+    let (mut c_run, mut c_eff, mut c_acc, mut c_unit, mut c_note) =
+        (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let mut nums: Vec<Vec<f64>> = vec![Vec::new(); 5];
+    for rd in runs {
+        let rig = (rd.rig.m_kg.is_finite() && rd.rig.l_m.is_finite()).then_some(KnownRig {
+            m_kg: rd.rig.m_kg,
+            a_m: rd.rig.l_m,
+            g_m_s2: rd.rig.g_m_s2,
+            r_b_m: rd.rig.r_b_m.is_finite().then_some(rd.rig.r_b_m),
+        });
+        let mut opts = DecayOptions {
+            rig,
+            ..DecayOptions::default()
+        };
+        if job.base == Base::Reference {
+            opts.base = vec![
+                Term::ViscousLinear,
+                Term::ViscousQuadratic,
+                Term::CoulombBearing,
+            ];
+            opts.candidates = vec![Term::CoulombConstant];
+        }
+        let d = diagnose_decay(&rd.enc_t_s, &rd.theta_rad, &opts)
+            .map_err(|e| JobError::Invalid(format!("run {}: free-decay analysis: {e}", rd.id)))?;
+        let _ = writeln!(text, "=== run {} (free decay) ===\n{d}", rd.id);
+        let _ = writeln!(report, "## Run `{}`\n\n```\n{d}```\n", rd.id);
+        for c in &d.candidates {
+            c_run.push(rd.id.clone());
+            c_eff.push(c.term.clone());
+            c_acc.push(c.accepted);
+            c_unit.push(c.unit.clone());
+            c_note.push(c.verdict.clone());
+            for (col, v) in
+                nums.iter_mut()
+                    .zip([c.estimate, c.ci_low, c.ci_high, c.delta_bic, c.heldout_gain])
+            {
+                col.push(v);
+            }
+        }
+        for u in &d.unexplained {
+            c_run.push(rd.id.clone());
+            c_eff.push("unexplained".into());
+            c_acc.push(false);
+            c_unit.push(u.unit.clone());
+            c_note.push(format!("{}: {} ({})", u.what, u.detail, u.location));
+            for (col, v) in
+                nums.iter_mut()
+                    .zip([u.magnitude, f64::NAN, f64::NAN, f64::NAN, f64::NAN])
+            {
+                col.push(v);
+            }
+        }
+        decays.push((rd.id.clone(), d));
+    }
+    let f = |name: &str, unit: &str, v: Vec<f64>| Column::f64(name, unit, v);
+    let [est, lo, hi, bic, gain]: [Vec<f64>; 5] = nums.try_into().unwrap_or_default();
+    pendulum_report::TableOptions::new()
+        .meta("command", "pendulum discover")
+        .meta("pipeline", pipeline_json.to_string())
+        .meta("base", job.base.name())
+        .meta(
+            "analysis",
+            "free decay (identifiable ratios: estimates are dimensionless, see unit)",
+        )
+        .write(
+            &out.join("diagnosis.parquet"),
+            &[
+                Column::new("run_id", ColumnData::Str(c_run)),
+                Column::new("effect", ColumnData::Str(c_eff)),
+                Column::new("accepted", ColumnData::Bool(c_acc)),
+                f("estimate", "see column unit", est),
+                f("ci_low", "see column unit", lo),
+                f("ci_high", "see column unit", hi),
+                Column::new("unit", ColumnData::Str(c_unit)),
+                f("delta_bic", "1", bic),
+                f("heldout_gain", "1 (fraction)", gain),
+                Column::new("note", ColumnData::Str(c_note)),
+            ],
+        )?;
+    let report_path = out.join("report.md");
+    std::fs::write(&report_path, report).map_err(|source| JobError::Io {
+        path: report_path.clone(),
+        source,
+    })?;
+    let _ = writeln!(text, "report: {}", report_path.display());
+    Ok(DiscoverSummary {
+        out_dir: out.clone(),
+        report: report_path,
+        discovery: Discovery {
+            base: pendulum_process::identify::FitOutcome {
+                spec: pendulum_process::fit::ModelSpec::linear(),
+                params: Vec::new(),
+                f_obj: f64::NAN,
+                e_theta: f64::NAN,
+                generations: 0,
+                evaluations: 0,
+                abandoned: 0,
+                stop_reason: "free decay".into(),
+                wall_s: 0.0,
+                seed: 0,
+                np: 0,
+                convergence: Vec::new(),
+                runs: Vec::new(),
+                polished: None,
+            },
+            extended: None,
+            rows: Vec::new(),
+            weak: Vec::new(),
+            weak_runs: Vec::new(),
+            residual_base: Vec::new(),
+            residual_final: Vec::new(),
+            validation_base: Vec::new(),
+            validation_final: Vec::new(),
+            unexplained: None,
+        },
+        decays,
         text,
     })
 }

@@ -251,10 +251,11 @@ fn window_error(
     if n == 0 {
         return Window::Done(0.0, y0);
     }
-    let mut starts: Vec<(usize, f64, [f64; 2])> = vec![(0, 0.0, y0)];
+    // Initial and restart states are in measured coordinates (θ_meas = θ + offset).
+    let mut starts: Vec<(usize, f64, [f64; 2])> = vec![(0, 0.0, [y0[0] - offset, y0[1]])];
     for &(i, y) in &run.restarts {
         if i > 0 && i < n {
-            starts.push((i, run.t[i], y));
+            starts.push((i, run.t[i], [y[0] - offset, y[1]]));
         }
     }
     let mut seg_opts = *opts;

@@ -492,7 +492,7 @@ pub fn residual_series(
         &model,
         &SimOptions::with_tol(1e-9),
         0.0,
-        ic_fit,
+        [ic_fit[0] - offset, ic_fit[1]],
         t_last,
         times.iter().copied(),
         |s| {

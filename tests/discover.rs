@@ -1,0 +1,201 @@
+//! Issue 5: hide one catalogue effect in a twin campaign made by the project's own rig simulator
+//! (sensor noise, quantisation, jitter, glitches as in rig.md), run `discover` without telling it
+//! what was hidden, and check the diagnosis. Effect sizes are drawn (seeded) from plausible
+//! ranges, not picked; the analysis never reads truth.json.
+
+use std::path::Path;
+
+use pendulum_discover::Base;
+use pendulum_jobs::discover::{run, DiscoverJob, DiscoverSummary};
+use rand::{RngExt, SeedableRng};
+
+use crate::identify::make_campaign;
+
+/// Eight runs (five identify, three validate), both capture formats, mixed steady states.
+fn campaign(seed: u64, a: f64, b: f64, mu: f64, effects: &str) -> String {
+    let runs = [
+        ("r01", 1.30, "identify", "serial", 0.8, 0.0),
+        ("r02", 1.54, "identify", "sd", 1.5, 0.0),
+        ("r03", 1.65, "identify", "serial", 0.5, 0.0),
+        ("r04", 1.75, "identify", "sd", 1.0, -9.0),
+        ("r05", 1.75, "identify", "serial", 0.5, 0.0),
+        ("v01", 1.54, "validate", "sd", 1.2, 0.0),
+        ("v02", 1.65, "validate", "serial", 1.5, 0.0),
+        ("v03", 1.30, "validate", "sd", 0.6, 3.0),
+    ];
+    let mut s = format!(
+        "name = \"hidden\"\nseed = {seed}\n[rig]\nm_kg = 1.46\nl_m = 0.265\ncrank_r_m = 0.0725\nrod_L_m = 0.575\nr_b_m = 0.01225\n[truth]\na_kg_m = {a}\nb_n_s_m = {b}\nmu = {mu}\n[truth.effects]\n{effects}\n"
+    );
+    for (id, om, role, fmt, th, thd) in runs {
+        s += &format!(
+            "[[run]]\nid = \"{id}\"\nomega_hz = {om}\nrole = \"{role}\"\nformat = \"{fmt}\"\ntheta0_rad = {th}\ntheta_dot0_rad_s = {thd}\nfree_s = 4\nforced_s = 30\n"
+        );
+    }
+    s
+}
+
+fn discover(seed: u64, base: Base, a: f64, b: f64, mu: f64, effects: &str) -> DiscoverSummary {
+    let dir = tempfile::tempdir().unwrap();
+    let camp = dir.path().join("campaign");
+    make_campaign(&camp, &campaign(seed, a, b, mu, effects));
+    let s = run(&DiscoverJob {
+        input: camp,
+        out: dir.path().join("out"),
+        base,
+        pipeline: None,
+        generations: Some(300),
+        seed: None,
+        progress: false,
+    })
+    .unwrap();
+    eprintln!("{s}");
+    for f in [
+        "diagnosis.parquet",
+        "signatures.parquet",
+        "report.md",
+        "signatures.png",
+        "params.parquet",
+    ] {
+        assert!(Path::new(&s.out_dir).join(f).is_file(), "{f} missing");
+    }
+    s
+}
+
+/// Exactly `effect` accepted, its estimate within `rel` (or `abs`) of the truth, positive gain.
+fn assert_found(s: &DiscoverSummary, effect: &str, truth: f64, rel: f64, abs: f64) {
+    let accepted: Vec<&str> = s
+        .discovery
+        .rows
+        .iter()
+        .filter(|r| r.accepted)
+        .map(|r| r.effect.as_str())
+        .collect();
+    assert_eq!(accepted, vec![effect], "accepted {accepted:?}");
+    let row = s
+        .discovery
+        .rows
+        .iter()
+        .find(|r| r.effect == effect)
+        .unwrap();
+    let err = (row.estimate - truth).abs();
+    assert!(
+        err <= rel * truth.abs() || err <= abs,
+        "{effect}: estimate {} vs truth {truth}",
+        row.estimate
+    );
+    assert!(
+        row.ci_low > 0.0 || row.ci_high < 0.0,
+        "{effect}: interval includes 0"
+    );
+    assert!(
+        row.heldout_gain > 0.0,
+        "{effect}: held-out gain {}",
+        row.heldout_gain
+    );
+}
+
+fn rng(tag: u64) -> rand_chacha::ChaCha8Rng {
+    rand_chacha::ChaCha8Rng::seed_from_u64(0x5EED_0000 + tag)
+}
+
+#[test]
+fn regression_issue_5_nothing_hidden_nothing_named() {
+    let s = discover(105, Base::Reference, 0.0, 0.5, 0.15, "");
+    let accepted: Vec<&str> = s
+        .discovery
+        .rows
+        .iter()
+        .filter(|r| r.accepted)
+        .map(|r| r.effect.as_str())
+        .collect();
+    assert!(accepted.is_empty(), "false alarm: {accepted:?}");
+    assert!(s.discovery.extended.is_none());
+}
+
+/// The study's headline: the classic linear model on data with dry friction.
+#[test]
+fn regression_issue_5_linear_base_finds_bearing_friction() {
+    let mu = rng(1).random_range(0.08..0.2);
+    let s = discover(107, Base::Linear, 0.0, 0.3, mu, "");
+    assert_found(&s, "coulomb_bearing", mu, 0.25, 0.0);
+}
+
+#[test]
+fn regression_issue_5_linear_base_finds_quadratic_drag() {
+    let a = rng(2).random_range(0.05..0.2);
+    let s = discover(111, Base::Linear, a, 0.3, 0.0, "");
+    assert_found(&s, "viscous_quadratic", a, 0.25, 0.0);
+}
+
+#[test]
+fn regression_issue_5_finds_constant_dry_torque() {
+    let tc = rng(3).random_range(0.006..0.015);
+    let s = discover(
+        113,
+        Base::Reference,
+        0.0,
+        0.5,
+        0.15,
+        &format!("coulomb_constant_t_c_nm = {tc}"),
+    );
+    assert_found(&s, "coulomb_constant", tc, 0.25, 0.0);
+}
+
+#[test]
+fn regression_issue_5_finds_bearing_load_base_accel() {
+    let mu = rng(4).random_range(0.1..0.2);
+    let s = discover(
+        117,
+        Base::Reference,
+        0.0,
+        0.5,
+        mu,
+        "bearing_load_base_accel = true",
+    );
+    assert_found(&s, "bearing_load_base_accel", mu, 0.25, 0.0);
+}
+
+#[test]
+fn regression_issue_5_finds_position_torque() {
+    let mut r = rng(5);
+    let tp = r.random_range(0.015..0.04);
+    let phi = r.random_range(-3.0..3.0);
+    let s = discover(
+        119,
+        Base::Reference,
+        0.0,
+        0.5,
+        0.15,
+        &format!("position_torque = {{ t_p_nm = {tp}, k = 1, phi_p_rad = {phi} }}"),
+    );
+    assert_found(&s, "position_torque", tp, 0.25, 0.0);
+}
+
+#[test]
+fn regression_issue_5_finds_horizontal_base() {
+    let mut r = rng(6);
+    let d = r.random_range(0.02..0.08) * if r.random::<bool>() { 1.0 } else { -1.0 };
+    let s = discover(
+        123,
+        Base::Reference,
+        0.0,
+        0.5,
+        0.15,
+        &format!("horizontal_base_delta_rad = {d}"),
+    );
+    assert_found(&s, "horizontal_base", d, 0.25, 0.0);
+}
+
+#[test]
+fn regression_issue_5_finds_extra_inertia() {
+    let j = rng(7).random_range(0.005..0.02);
+    let s = discover(
+        127,
+        Base::Reference,
+        0.0,
+        0.5,
+        0.15,
+        &format!("extra_inertia_j_kg_m2 = {j}"),
+    );
+    assert_found(&s, "extra_inertia", j, 0.25, 0.0);
+}
