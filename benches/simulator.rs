@@ -69,7 +69,8 @@ fn main() {
     d.lambda = 0.126;
     d.beta = 0.109;
     d.m_coulomb = 0.007;
-    let cases: [(&str, f64, fn(SteadyClass) -> bool); 2] = [
+    type Case = (&'static str, f64, fn(SteadyClass) -> bool);
+    let cases: [Case; 2] = [
         ("rotating", 1.585, |c| c.is_rotation()),
         ("oscillating", 2.0, |c| c == SteadyClass::Oscillation),
     ];
