@@ -404,8 +404,10 @@ mod tests {
 
     #[test]
     fn dimensionless_round_trip() {
-        let mut p = Physical::default();
-        p.a_kg_m = 0.01;
+        let mut p = Physical {
+            a_kg_m: 0.01,
+            ..Physical::default()
+        };
         p.effects.coulomb_constant_t_c_nm = Some(0.004);
         p.effects.position_torque = Some(PositionTorque {
             t_p_nm: 0.01,

@@ -453,7 +453,7 @@ where
         let h_next = (h / fac).min(opts.h_max);
         if err > 1.0 {
             stats.rejected += 1;
-            h = h / (fac11 / 0.9).min(5.0);
+            h /= (fac11 / 0.9).min(5.0);
             if h < 1e-14 * t.abs().max(1.0) {
                 return Err(ModelError::StepUnderflow { t });
             }
