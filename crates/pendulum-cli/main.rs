@@ -333,6 +333,15 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                     "truth: a = {}, b = {}, μ = {}",
                     c.truth.params.a_kg_m, c.truth.params.b_n_s_m, c.truth.params.mu
                 );
+                println!("\nA second twin campaign with an effect hidden in it (named at the end) → discover:");
+                let d = demo::hidden_effect(&a.out, true)?;
+                print!("{d}");
+                println!("(hidden: horizontal_base, δ = 0.04 rad)");
+                println!(
+                    "\nWhere does it rotate? The study's dry-friction vs linear model over ω × R:"
+                );
+                let z = pendulum_jobs::zones::demo_comparison(&a.out.join("zones"), true)?;
+                print!("{z}");
             }
         }
     }

@@ -117,3 +117,50 @@ pub fn campaign(
         truth,
     })
 }
+
+/// The demo's discovery campaign: the study's rig with a guide tilted 0.04 rad from vertical
+/// (`horizontal_base`) hidden in the captures; five identify and three validate runs.
+pub fn discovery_case() -> String {
+    let runs = [
+        ("r01", 1.30, "identify", "serial", 0.8, 0.0),
+        ("r02", 1.54, "identify", "sd", 1.5, 0.0),
+        ("r03", 1.65, "identify", "serial", 0.5, 0.0),
+        ("r04", 1.75, "identify", "sd", 1.0, -9.0),
+        ("r05", 1.75, "identify", "serial", 0.5, 0.0),
+        ("v01", 1.54, "validate", "sd", 1.2, 0.0),
+        ("v02", 1.65, "validate", "serial", 1.5, 0.0),
+        ("v03", 1.30, "validate", "sd", 0.6, 3.0),
+    ];
+    let mut s = String::from(
+        "name = \"demo-hidden-effect\"\nseed = 2027\n[rig]\nm_kg = 1.46\nl_m = 0.265\ncrank_r_m = 0.0725\nrod_L_m = 0.575\nr_b_m = 0.01225\n[truth]\nb_n_s_m = 0.5\nmu = 0.15\n[truth.effects]\nhorizontal_base_delta_rad = 0.04\n",
+    );
+    for (id, om, role, fmt, th, thd) in runs {
+        s += &format!(
+            "[[run]]\nid = \"{id}\"\nomega_hz = {om}\nrole = \"{role}\"\nformat = \"{fmt}\"\ntheta0_rad = {th}\ntheta_dot0_rad_s = {thd}\nfree_s = 4\nforced_s = 30\n"
+        );
+    }
+    s
+}
+
+/// Writes the discovery campaign into `out/hidden` and runs `discover` on it (reference base).
+pub fn hidden_effect(
+    out: &std::path::Path,
+    progress: bool,
+) -> Result<crate::discover::DiscoverSummary, JobError> {
+    use pendulum_rig::twin::{synthesize, TwinCase};
+    let dir = out.join("hidden");
+    let case = TwinCase::from_toml(
+        &discovery_case(),
+        std::path::Path::new("<built-in discovery case>"),
+    )?;
+    synthesize(&case, &dir)?;
+    crate::discover::run(&crate::discover::DiscoverJob {
+        input: dir,
+        out: out.join("discover"),
+        base: pendulum_discover::Base::Reference,
+        pipeline: None,
+        generations: Some(300),
+        seed: None,
+        progress,
+    })
+}

@@ -260,6 +260,10 @@ pub fn run(dir: &Path, out_dir: &Path, show_progress: bool) -> Result<IngestSumm
                     warnings: Vec::new(),
                 })
             };
+            if row.error.is_some() {
+                // A stale <id>.mcap from an earlier ingest would make the folder look complete.
+                let _ = std::fs::remove_file(out_dir.join(format!("{}.mcap", spec.id)));
+            }
             bar.set_message(spec.id.clone());
             bar.inc(1);
             row
