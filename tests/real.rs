@@ -280,3 +280,38 @@ fn multiarm_free_decays_need_dry_friction() {
         dl.unexplained
     );
 }
+
+/// The command a user runs: `pendulum discover` on the MultiArm campaign, starting from the
+/// authors' viscous-only model, names the dry friction it misses (accepted, with its interval)
+/// in its printed diagnosis and writes diagnosis.parquet.
+#[test]
+fn multiarm_discover_command_names_dry_friction() {
+    let data = data_dir();
+    let tmp = tempfile::tempdir().expect("temp dir");
+    let camp = tmp.path().join("campaign");
+    std::fs::create_dir_all(&camp).expect("campaign dir");
+    std::fs::write(camp.join("campaign.toml"), campaign_toml(&data)).expect("write campaign");
+    let out = tmp.path().join("out");
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_pendulum"))
+        .args(["discover", "--base", "linear", "--quiet", "--out"])
+        .arg(&out)
+        .arg(&camp)
+        .output()
+        .expect("run pendulum discover");
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let small = text
+        .split("=== run small")
+        .nth(1)
+        .expect("small run's diagnosis");
+    let small = small.split("=== run").next().unwrap_or(small);
+    let dry = small
+        .lines()
+        .find(|l| l.trim_start().starts_with("1  coulomb_constant"))
+        .unwrap_or_else(|| panic!("no coulomb_constant row:\n{small}"));
+    assert!(
+        dry.trim_end().ends_with("yes"),
+        "dry friction not accepted: {dry}"
+    );
+    assert!(out.join("diagnosis.parquet").is_file() && out.join("report.md").is_file());
+}
