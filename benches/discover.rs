@@ -9,22 +9,14 @@ use pendulum_jobs::discover::{run, DiscoverJob};
 use pendulum_rig::twin::{synthesize, TwinCase};
 
 fn main() {
-    let runs = [
-        ("r01", 1.30, "identify", "serial", 0.8, 0.0),
-        ("r02", 1.54, "identify", "sd", 1.5, 0.0),
-        ("r03", 1.65, "identify", "serial", 0.5, 0.0),
-        ("r04", 1.75, "identify", "sd", 1.0, -9.0),
-        ("r05", 1.75, "identify", "serial", 0.5, 0.0),
-        ("v01", 1.54, "validate", "sd", 1.2, 0.0),
-        ("v02", 1.65, "validate", "serial", 1.5, 0.0),
-        ("v03", 1.30, "validate", "sd", 0.6, 3.0),
-    ];
-    let mut case = String::from(
-        "name = \"bench\"\nseed = 3\n[rig]\nm_kg = 1.46\nl_m = 0.265\ncrank_r_m = 0.0725\nrod_L_m = 0.575\nr_b_m = 0.01225\n[truth]\nb_n_s_m = 0.5\nmu = 0.15\n[truth.effects]\ncoulomb_constant_t_c_nm = 0.01\n",
+    let case = pendulum_jobs::demo::discovery_campaign(
+        "bench",
+        3,
+        0.0,
+        0.5,
+        0.15,
+        "coulomb_constant_t_c_nm = 0.01",
     );
-    for (id, om, role, fmt, th, thd) in runs {
-        case += &format!("[[run]]\nid = \"{id}\"\nomega_hz = {om}\nrole = \"{role}\"\nformat = \"{fmt}\"\ntheta0_rad = {th}\ntheta_dot0_rad_s = {thd}\nfree_s = 4\nforced_s = 30\n");
-    }
     let dir = tempfile::tempdir().expect("tempdir");
     let case = TwinCase::from_toml(&case, std::path::Path::new("bench.toml")).expect("case");
     synthesize(&case, &dir.path().join("c")).expect("twin");

@@ -11,27 +11,8 @@ use rand::{RngExt, SeedableRng};
 
 use crate::identify::make_campaign;
 
-/// Eight runs (five identify, three validate), both capture formats, mixed steady states.
 fn campaign(seed: u64, a: f64, b: f64, mu: f64, effects: &str) -> String {
-    let runs = [
-        ("r01", 1.30, "identify", "serial", 0.8, 0.0),
-        ("r02", 1.54, "identify", "sd", 1.5, 0.0),
-        ("r03", 1.65, "identify", "serial", 0.5, 0.0),
-        ("r04", 1.75, "identify", "sd", 1.0, -9.0),
-        ("r05", 1.75, "identify", "serial", 0.5, 0.0),
-        ("v01", 1.54, "validate", "sd", 1.2, 0.0),
-        ("v02", 1.65, "validate", "serial", 1.5, 0.0),
-        ("v03", 1.30, "validate", "sd", 0.6, 3.0),
-    ];
-    let mut s = format!(
-        "name = \"hidden\"\nseed = {seed}\n[rig]\nm_kg = 1.46\nl_m = 0.265\ncrank_r_m = 0.0725\nrod_L_m = 0.575\nr_b_m = 0.01225\n[truth]\na_kg_m = {a}\nb_n_s_m = {b}\nmu = {mu}\n[truth.effects]\n{effects}\n"
-    );
-    for (id, om, role, fmt, th, thd) in runs {
-        s += &format!(
-            "[[run]]\nid = \"{id}\"\nomega_hz = {om}\nrole = \"{role}\"\nformat = \"{fmt}\"\ntheta0_rad = {th}\ntheta_dot0_rad_s = {thd}\nfree_s = 4\nforced_s = 30\n"
-        );
-    }
-    s
+    pendulum_jobs::demo::discovery_campaign("hidden", seed, a, b, mu, effects)
 }
 
 fn discover(seed: u64, base: Base, a: f64, b: f64, mu: f64, effects: &str) -> DiscoverSummary {

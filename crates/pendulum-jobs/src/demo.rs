@@ -118,9 +118,10 @@ pub fn campaign(
     })
 }
 
-/// The demo's discovery campaign: the study's rig with a guide tilted 0.04 rad from vertical
-/// (`horizontal_base`) hidden in the captures; five identify and three validate runs.
-pub fn discovery_case() -> String {
+/// An eight-run twin case (five identify, three validate runs; both capture formats; mixed
+/// steady states) on the study's rig with damping a, b, μ and `effects` (a TOML table body for
+/// `[truth.effects]`): the discovery campaign of the demo, the tests and the benchmark.
+pub fn discovery_campaign(name: &str, seed: u64, a: f64, b: f64, mu: f64, effects: &str) -> String {
     let runs = [
         ("r01", 1.30, "identify", "serial", 0.8, 0.0),
         ("r02", 1.54, "identify", "sd", 1.5, 0.0),
@@ -131,8 +132,8 @@ pub fn discovery_case() -> String {
         ("v02", 1.65, "validate", "serial", 1.5, 0.0),
         ("v03", 1.30, "validate", "sd", 0.6, 3.0),
     ];
-    let mut s = String::from(
-        "name = \"demo-hidden-effect\"\nseed = 2027\n[rig]\nm_kg = 1.46\nl_m = 0.265\ncrank_r_m = 0.0725\nrod_L_m = 0.575\nr_b_m = 0.01225\n[truth]\nb_n_s_m = 0.5\nmu = 0.15\n[truth.effects]\nhorizontal_base_delta_rad = 0.04\n",
+    let mut s = format!(
+        "name = \"{name}\"\nseed = {seed}\n[rig]\nm_kg = 1.46\nl_m = 0.265\ncrank_r_m = 0.0725\nrod_L_m = 0.575\nr_b_m = 0.01225\n[truth]\na_kg_m = {a}\nb_n_s_m = {b}\nmu = {mu}\n[truth.effects]\n{effects}\n"
     );
     for (id, om, role, fmt, th, thd) in runs {
         s += &format!(
@@ -140,6 +141,19 @@ pub fn discovery_case() -> String {
         );
     }
     s
+}
+
+/// The demo's discovery campaign: a guide tilted 0.04 rad from vertical (`horizontal_base`)
+/// hidden in the captures.
+pub fn discovery_case() -> String {
+    discovery_campaign(
+        "demo-hidden-effect",
+        2027,
+        0.0,
+        0.5,
+        0.15,
+        "horizontal_base_delta_rad = 0.04",
+    )
 }
 
 /// Writes the discovery campaign into `out/hidden` and runs `discover` on it (reference base).
