@@ -148,6 +148,16 @@ fn stats_json(stats: &IngestStats, format: &str) -> serde_json::Value {
     })
 }
 
+/// Rig captures always carry the accelerometer; a generic time series only when the campaign
+/// names an acceleration column (no channel at all otherwise, rather than an empty one).
+fn has_accelerometer(spec: &RunSpec) -> bool {
+    spec.format.as_deref() != Some("timeseries")
+        || spec
+            .extra
+            .keys()
+            .any(|k| k.starts_with("accel_") && k.ends_with("_column"))
+}
+
 fn ingest_run(c: &Campaign, spec: &RunSpec, out_dir: &Path) -> Result<IngestRow, JobError> {
     let opts = ReadOptions {
         g_m_s2: c.g_m_s2,
@@ -172,6 +182,7 @@ fn ingest_run(c: &Campaign, spec: &RunSpec, out_dir: &Path) -> Result<IngestRow,
     let mut w = RunLogOptions::new()
         .library(concat!("pendulum/", env!("CARGO_PKG_VERSION")))
         .start_ns(start_ns)
+        .accel_channel(has_accelerometer(spec))
         .create(&path)?;
     w.write_metadata(METADATA_RUN, run_metadata(c, spec))?;
     w.write_metadata(

@@ -57,6 +57,7 @@ pub struct RunLogOptions {
     chunk_size_bytes: u64,
     compression_zstd: bool,
     start_ns: Option<u64>,
+    accel_channel: bool,
 }
 
 impl Default for RunLogOptions {
@@ -66,6 +67,7 @@ impl Default for RunLogOptions {
             chunk_size_bytes: mcap::WriteOptions::DEFAULT_CHUNK_SIZE,
             compression_zstd: true,
             start_ns: None,
+            accel_channel: true,
         }
     }
 }
@@ -99,6 +101,13 @@ impl RunLogOptions {
     /// [`RunLogWriter::set_start_ns`]); the same as calling that before the first message.
     pub fn start_ns(mut self, start_ns: Option<u64>) -> Self {
         self.start_ns = start_ns;
+        self
+    }
+
+    /// Create the `/accel` channel even before (or without) any message (default true). A
+    /// recording with no accelerometer passes false and gets no `/accel` channel at all.
+    pub fn accel_channel(mut self, on: bool) -> Self {
+        self.accel_channel = on;
         self
     }
 
@@ -152,7 +161,9 @@ impl RunLogOptions {
             .map_err(|source| writer.write_err("start the file", source))?;
         writer.mcap = Some(mcap);
         writer.ensure_channel(Topic::Encoder)?;
-        writer.ensure_channel(Topic::Accel)?;
+        if self.accel_channel {
+            writer.ensure_channel(Topic::Accel)?;
+        }
         Ok(writer)
     }
 }
