@@ -9,6 +9,7 @@ pub mod capture;
 pub mod crc8;
 pub mod detect;
 pub mod error;
+mod lines;
 pub mod sd;
 pub mod serial;
 

@@ -3,6 +3,7 @@
 //! The reader streams line by line with a bounded line buffer, so memory does not grow with the
 //! file (nor with a "line" of binary garbage that never ends).
 
+use crate::lines::{read_bounded_line, LineInfo};
 use std::collections::VecDeque;
 use std::io::{self, BufRead, Write};
 use std::path::{Path, PathBuf};
@@ -18,16 +19,6 @@ pub const COLUMN_LINE: &str = "t_us,enc,ax,ay,az";
 
 /// Longer lines are garbage: a real sample line is at most ~40 bytes.
 const MAX_LINE_BYTES: usize = 1024;
-
-/// One line as read: content in the reader's buffer (without `\n`/`\r\n`), capped at
-/// [`MAX_LINE_BYTES`].
-struct LineInfo {
-    number: u64,
-    /// Bytes in the file, line end included.
-    bytes: u64,
-    overlong: bool,
-    terminated: bool,
-}
 
 /// A syntactically valid data line, not yet accepted.
 struct Row {
@@ -175,50 +166,13 @@ impl<R: BufRead> SerialReader<R> {
 
     /// Reads one line into `self.line`, keeping at most [`MAX_LINE_BYTES`] of it.
     fn read_line(&mut self) -> Result<Option<LineInfo>, RigError> {
-        self.line.clear();
-        let mut bytes = 0u64;
-        let mut overlong = false;
-        let mut terminated = false;
-        loop {
-            let avail = match self.reader.fill_buf() {
-                Ok(b) => b,
-                Err(e) if e.kind() == io::ErrorKind::Interrupted => continue,
-                Err(e) => return Err(RigError::io(&self.path, e)),
-            };
-            if avail.is_empty() {
-                break;
-            }
-            let (chunk, used) = match avail.iter().position(|&b| b == b'\n') {
-                Some(i) => {
-                    terminated = true;
-                    (&avail[..i], i + 1)
-                }
-                None => (avail, avail.len()),
-            };
-            let room = MAX_LINE_BYTES.saturating_sub(self.line.len());
-            if chunk.len() > room {
-                overlong = true;
-            }
-            self.line.extend_from_slice(&chunk[..chunk.len().min(room)]);
-            self.reader.consume(used);
-            bytes += used as u64;
-            if terminated {
-                break;
-            }
-        }
-        if bytes == 0 {
-            return Ok(None);
-        }
-        if self.line.last() == Some(&b'\r') {
-            self.line.pop();
-        }
-        self.line_no += 1;
-        Ok(Some(LineInfo {
-            number: self.line_no,
-            bytes,
-            overlong,
-            terminated,
-        }))
+        read_bounded_line(
+            &mut self.reader,
+            &mut self.line,
+            &mut self.line_no,
+            MAX_LINE_BYTES,
+        )
+        .map_err(|e| RigError::io(&self.path, e))
     }
 
     /// The next syntactically valid data line; damaged ones are recorded and skipped.

@@ -34,6 +34,7 @@
 //! when accelerometer columns are given, an `AccelSample` at the same time (axes without a column
 //! read 0; `raw` is the equivalent at 8192 LSB/g, saturated, and the header says so).
 
+use crate::lines::{read_bounded_line, LineInfo};
 use std::collections::{BTreeMap, VecDeque};
 use std::f64::consts::TAU;
 use std::io::{self, BufRead};
@@ -305,13 +306,6 @@ impl TimeseriesSpec {
     fn has_accel(&self) -> bool {
         self.accel_columns.iter().any(Option::is_some)
     }
-}
-
-/// One line as read (content in the reader's buffer, without the line end).
-struct LineInfo {
-    number: u64,
-    bytes: u64,
-    overlong: bool,
 }
 
 /// A parsed data line, not yet accepted.
@@ -611,45 +605,13 @@ impl<R: BufRead> TimeseriesReader<R> {
 
     /// Reads one line into `self.line`, keeping at most [`MAX_LINE_BYTES`] of it.
     fn read_line(&mut self) -> Result<Option<LineInfo>, RigError> {
-        self.line.clear();
-        let mut bytes = 0u64;
-        let mut overlong = false;
-        loop {
-            let avail = match self.reader.fill_buf() {
-                Ok(b) => b,
-                Err(e) if e.kind() == io::ErrorKind::Interrupted => continue,
-                Err(e) => return Err(RigError::io(&self.path, e)),
-            };
-            if avail.is_empty() {
-                break;
-            }
-            let (chunk, used, done) = match avail.iter().position(|&b| b == b'\n') {
-                Some(i) => (&avail[..i], i + 1, true),
-                None => (avail, avail.len(), false),
-            };
-            let room = MAX_LINE_BYTES.saturating_sub(self.line.len());
-            if chunk.len() > room {
-                overlong = true;
-            }
-            self.line.extend_from_slice(&chunk[..chunk.len().min(room)]);
-            self.reader.consume(used);
-            bytes += used as u64;
-            if done {
-                break;
-            }
-        }
-        if bytes == 0 {
-            return Ok(None);
-        }
-        if self.line.last() == Some(&b'\r') {
-            self.line.pop();
-        }
-        self.line_no += 1;
-        Ok(Some(LineInfo {
-            number: self.line_no,
-            bytes,
-            overlong,
-        }))
+        read_bounded_line(
+            &mut self.reader,
+            &mut self.line,
+            &mut self.line_no,
+            MAX_LINE_BYTES,
+        )
+        .map_err(|e| RigError::io(&self.path, e))
     }
 
     /// The next parsable data line; damaged ones are recorded and skipped.
