@@ -60,6 +60,7 @@ impl Default for DiscoverConfig {
                     window_s: 10.0,
                     sample_hz: 100.0,
                     segment_s: Some(0.5),
+                    t_sim_s: None,
                 },
                 sim_tol: 1e-6,
                 ..ValidateConfig::default()

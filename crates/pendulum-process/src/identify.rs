@@ -31,6 +31,10 @@ pub struct Window {
     /// study's method, which chaotic transients make meaningless beyond a few seconds.
     #[serde(default)]
     pub segment_s: Option<f64>,
+    /// The study's t_sim: how long past the window the steady-state penalty simulates, s;
+    /// `None` = to the end of the capture, classified over the same tail as the measurement.
+    #[serde(default)]
+    pub t_sim_s: Option<f64>,
 }
 
 impl Default for Window {
@@ -39,6 +43,7 @@ impl Default for Window {
             window_s: 10.0,
             sample_hz: 100.0,
             segment_s: None,
+            t_sim_s: None,
         }
     }
 }
@@ -71,8 +76,17 @@ pub fn prepare_run(
     let period_s = 1.0 / al.omega_hz;
     let t_end = t[t.len() - 1];
     let mut tail_t = Vec::new();
-    let mut x = t_end - steady_cfg.tail_s;
-    while x <= t_end - 0.25 * period_s {
+    // The simulated steady state is classified over the same span as the measured one (the
+    // capture's last `tail_s`), or, with `t_sim_s`, over the second half of t_sim after the window.
+    let (from, to) = match window.t_sim_s {
+        Some(ts) => (
+            al.t0_s + window.window_s + 0.5 * ts,
+            al.t0_s + window.window_s + ts,
+        ),
+        None => (t_end - steady_cfg.tail_s, t_end),
+    };
+    let mut x = from;
+    while x <= to - 0.25 * period_s {
         tail_t.push(w0 * (x - al.t0_s));
         x += period_s;
     }
