@@ -156,3 +156,28 @@ fn demo_prints_the_study_contrast() {
         "{text}"
     );
 }
+
+/// Every stage config in pipelines/ parses, validates and builds; a misspelled key is an error
+/// that names the line.
+#[test]
+fn pipeline_files_parse_and_build() {
+    use pendulum_process::pipeline::PipelineConfig;
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("pipelines");
+    for name in ["identify.toml", "validate.toml"] {
+        let p = PipelineConfig::load(&dir.join(name)).unwrap();
+        assert!(!p.stages.is_empty(), "{name}");
+        for s in &p.stages {
+            s.build().unwrap_or_else(|e| panic!("{name}: {e}"));
+        }
+    }
+    let text = std::fs::read_to_string(dir.join("discover.toml")).unwrap();
+    let d: pendulum_jobs::discover::DiscoverPipeline = toml::from_str(&text).unwrap();
+    for s in &d.stages {
+        s.build().unwrap();
+    }
+    let bad = "name = \"x\"\n[[stage]]\ntype = \"align\"\nfit_windw_s = 3.0\n";
+    let e = PipelineConfig::from_toml(bad, std::path::Path::new("bad.toml"))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("bad.toml:") && e.contains("fit_windw_s"), "{e}");
+}
