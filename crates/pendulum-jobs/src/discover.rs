@@ -497,9 +497,7 @@ fn signature_plot(path: &Path, d: &Discovery) -> Result<(), JobError> {
         ..Panel::default()
     };
     let fig = Figure {
-        title:
-            "Where the model departs from the rig: weak-form equation error on the identify runs"
-                .into(),
+        title: "Unexplained torque (weak-form equation error), identify runs".into(),
         panels: vec![
             panel(
                 "against angular velocity (dry friction: a step at dθ/dt = 0)",
