@@ -138,7 +138,6 @@ fn regression_issue_5_finds_bearing_load_base_accel() {
 }
 
 #[test]
-#[ignore = "known failure (issue 5 note): position_torque found, but a tiny horizontal_base (0.9 mrad) is accepted after it"]
 fn regression_issue_5_finds_position_torque() {
     let mut r = rng(5);
     let tp = r.random_range(0.015..0.04);

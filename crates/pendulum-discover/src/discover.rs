@@ -9,9 +9,9 @@
 //!    max(`gain_min`, 3 × the validation's own noise) — the noise being the relative change of
 //!    the base model's held-out E_θ between two validations with different seeds — or their
 //!    equation error (coefficients from the identify runs) falls by more than `eq_gain_min`
-//!    while E_θ does not rise by more than that noise. (Sensor effects such as an
-//!    accelerometer lag move E_θ on 0.5 s shooting segments very little but the equation error
-//!    a lot.)
+//!    while E_θ does not fall below zero gain. (Sensor effects such as an accelerometer lag move
+//!    E_θ on 0.5 s shooting segments very little but the equation error a lot.) A second effect,
+//!    added to a model already extended, needs both measures.
 //!
 //! After the accepted effects are in, the remaining equation error is binned against θ̇, θ and the
 //! forcing phase; a one-way analysis of variance with p < 1e-6 on any of them is reported as
@@ -422,7 +422,7 @@ pub fn discover(
     let mut baseline: Option<Vec<RunFit>> = None;
     let mut rows: Vec<DiagnosisRow> = Vec::new();
     let mut confirmed: Vec<(String, DiagnosisRow)> = Vec::new();
-    for sc in &chosen {
+    for (round, sc) in chosen.iter().enumerate() {
         let c = &sc.candidate;
         let cols = with_candidate(&current_cols, c);
         let Some(fit) = ols(&id_rows, &cols) else {
@@ -471,11 +471,18 @@ pub fn discover(
         };
         let ci = (est - 1.96 * se, est + 1.96 * se);
         let excludes_zero = ci.0 > 0.0 || ci.1 < 0.0;
+        // A first effect needs one of the two held-out measures; a second one, added to a model
+        // already extended, needs both (a pair must not be a first effect's leftovers).
+        let held_out = if round == 0 {
+            gain > gain_needed || eq_gain > cfg.eq_gain_min
+        } else {
+            gain > gain_needed && eq_gain > cfg.eq_gain_min
+        };
         let accepted = excludes_zero
             && practically_significant(&c.effect, est)
             && sc.delta_bic < cfg.screen_threshold
             && gain > 0.0
-            && (gain > gain_needed || eq_gain > cfg.eq_gain_min);
+            && held_out;
         // The refitted value of the effect's first parameter (μ for bearing_load_base_accel).
         let refit_est = match c.effect.as_str() {
             "bearing_load_base_accel" => spec
