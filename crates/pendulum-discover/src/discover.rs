@@ -178,7 +178,7 @@ fn to_si(c: &Candidate, fit: &crate::screen::Ols, s: &Scales) -> (f64, f64, &'st
 /// `encoder_offset`.
 fn practically_significant(effect: &str, estimate: f64) -> bool {
     match effect {
-        "encoder_offset" => estimate.abs() > 4.0 * 2.0 * std::f64::consts::PI / 4096.0,
+        "encoder_offset" => estimate.abs() > crate::screen::ENCODER_OFFSET_FLOOR_RAD,
         _ => true,
     }
 }
@@ -379,6 +379,20 @@ pub fn discover(
             weak_runs.push((run.id.clone(), run.role));
         }
     }
+    // Weights from the residual variance of the whole catalogue's fit (so that a missing effect's
+    // own torque does not count as noise and down-weight where it lives).
+    {
+        let id_rows: Vec<WeakRow> = weak
+            .iter()
+            .filter(|r| weak_runs[r.run].1 == Role::Identify)
+            .cloned()
+            .collect();
+        let all: Vec<usize> = (0..=crate::weak::DELAY).collect();
+        if let Some(full) = ols(&id_rows, &all).or_else(|| ols(&id_rows, &base.columns())) {
+            let res = full.residuals(&weak);
+            crate::weak::set_weights(&mut weak, &res);
+        }
+    }
     let id_rows: Vec<WeakRow> = weak
         .iter()
         .filter(|r| weak_runs[r.run].1 == Role::Identify)
@@ -390,8 +404,13 @@ pub fn discover(
         .cloned()
         .collect();
     // Held-out equation error: coefficients fitted on the identify runs, scored on the validate runs.
-    let rss_val =
-        |fit: &crate::screen::Ols| -> f64 { fit.residuals(&val_rows).iter().map(|e| e * e).sum() };
+    let rss_val = |fit: &crate::screen::Ols| -> f64 {
+        fit.residuals(&val_rows)
+            .iter()
+            .zip(&val_rows)
+            .map(|(e, r)| r.weight * e * e)
+            .sum()
+    };
     let base_ols = ols(&id_rows, &base.columns()).ok_or_else(|| ProcessError::Run {
         run: "(identify runs)".into(),
         reason: format!(
@@ -402,7 +421,8 @@ pub fn discover(
     let residual_base = base_ols.residuals(&weak);
 
     // Screen.
-    let (chosen, first_round) = stepwise(&id_rows, base, cfg.screen_threshold, cfg.max_effects);
+    let screened = stepwise(&id_rows, base, cfg.screen_threshold, cfg.max_effects);
+    let (chosen, first_round) = (&screened.chosen, &screened.first_round);
 
     // Held-out noise: the base model's validation with two seeds.
     let v1 = validate(&val_runs, &base_fit.spec, &base_fit.params, &cfg.validate)?;
@@ -419,6 +439,7 @@ pub fn discover(
     let mut current = base_fit.clone();
     let mut current_val = if e1 <= e2 { v1.clone() } else { v2.clone() };
     let mut current_cols = base.columns();
+    current_cols.extend(screened.nuisance.iter().copied());
     let mut baseline: Option<Vec<RunFit>> = None;
     let mut rows: Vec<DiagnosisRow> = Vec::new();
     let mut confirmed: Vec<(String, DiagnosisRow)> = Vec::new();
@@ -498,7 +519,9 @@ pub fn discover(
         let row = DiagnosisRow {
             effect: c.effect.clone(),
             accepted,
-            estimate: if accepted { refit_est } else { est },
+            // The equation-error estimate, so that the estimate and its interval come from the
+            // same regression; the trajectory refit's value is in the note and params.parquet.
+            estimate: est,
             ci_low: ci.0,
             ci_high: ci.1,
             unit: unit.into(),
@@ -508,7 +531,7 @@ pub fn discover(
             e_validate_before: before,
             e_validate_after: after,
             note: format!(
-                "{}{}; held-out equation-error fall {:.1} %; refit f_obj {:.4}; E_θ gain needed > {:.3} (validation noise {:.3})",
+                "{}{}; trajectory refit {:.4e} {}; held-out equation-error fall {:.1} %; refit f_obj {:.4}; E_θ gain needed > {:.3} (validation noise {:.3})",
                 if c.effect == "position_torque" {
                     format!("k = {}; ", c.k)
                 } else {
@@ -519,6 +542,8 @@ pub fn discover(
                 } else {
                     "interval includes 0"
                 },
+                refit_est,
+                unit,
                 100.0 * eq_gain,
                 f,
                 gain_needed,
@@ -568,7 +593,7 @@ pub fn discover(
 
     // One row per candidate tried in the first screening round (position_torque: its best k).
     let mut seen = std::collections::BTreeSet::new();
-    for sc in &first_round {
+    for sc in first_round {
         if !seen.insert(sc.candidate.effect.clone()) {
             continue;
         }
@@ -591,6 +616,8 @@ pub fn discover(
             e_validate_after: f64::NAN,
             note: if sc.candidate.effect == "position_torque" {
                 format!("k = {}; screened out", sc.candidate.k)
+            } else if sc.candidate.add.iter().all(|c| screened.nuisance.contains(c)) {
+                "within the rig's zeroing tolerance (under 4 counts): kept as a nuisance term, not named".into()
             } else {
                 "screened out".into()
             },

@@ -130,17 +130,18 @@ impl Ols {
     }
 }
 
-/// OLS of the target on `columns` (columns are scaled for conditioning).
+/// Weighted least squares of the target on `columns` (weights [`WeakRow::weight`]; columns are
+/// scaled for conditioning). `rss` is the weighted sum of squares.
 pub fn ols(rows: &[WeakRow], columns: &[usize]) -> Option<Ols> {
     let p = columns.len();
-    let n = rows.len();
+    let n = rows.iter().filter(|r| r.weight > 0.0).count();
     if n <= p + 2 {
         return None;
     }
     let scale: Vec<f64> = columns
         .iter()
         .map(|&c| {
-            (rows.iter().map(|r| r.x[c] * r.x[c]).sum::<f64>() / n as f64)
+            (rows.iter().map(|r| r.weight * r.x[c] * r.x[c]).sum::<f64>() / n as f64)
                 .sqrt()
                 .max(1e-300)
         })
@@ -149,7 +150,7 @@ pub fn ols(rows: &[WeakRow], columns: &[usize]) -> Option<Ols> {
     let mut atb = vec![0.0; p];
     for r in rows {
         for i in 0..p {
-            let xi = r.x[columns[i]] / scale[i];
+            let xi = r.weight * r.x[columns[i]] / scale[i];
             atb[i] += xi * r.target;
             for j in 0..p {
                 ata[i * p + j] += xi * r.x[columns[j]] / scale[j];
@@ -164,7 +165,7 @@ pub fn ols(rows: &[WeakRow], columns: &[usize]) -> Option<Ols> {
     let mut rss = 0.0;
     for r in rows {
         let fit: f64 = (0..p).map(|i| r.x[columns[i]] / scale[i] * beta[i]).sum();
-        rss += (r.target - fit).powi(2);
+        rss += r.weight * (r.target - fit).powi(2);
     }
     let s2 = rss / (n - p) as f64;
     let inv = if p == 0 {
@@ -228,22 +229,47 @@ pub fn screen(rows: &[WeakRow], current: &[usize], cands: &[Candidate]) -> Vec<S
     out
 }
 
+/// The encoder is zeroed by hand to within a few counts (rig.md): an offset under 4 counts
+/// (6.1 mrad) is the rig's normal zeroing error, not the effect `encoder_offset`.
+pub const ENCODER_OFFSET_FLOOR_RAD: f64 = 4.0 * 2.0 * std::f64::consts::PI / 4096.0;
+
+/// Whether a screened candidate is a normal tolerance of the rig rather than an effect: then it
+/// is kept in the regression as a nuisance term (so that its torque, e.g. a one-count zero error's
+/// m g l θ_off cos θ, is not mistaken for a position torque) but never named.
+pub fn is_nuisance(s: &Screened) -> bool {
+    s.candidate.effect == "encoder_offset"
+        && s
+            .fit
+            .coef_of(15)
+            .is_some_and(|(v, _)| v.abs() <= ENCODER_OFFSET_FLOOR_RAD)
+}
+
+/// Result of the forward stepwise screen.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Stepwise {
+    /// Effects in the order chosen.
+    pub chosen: Vec<Screened>,
+    /// The first round's ranking of every candidate against the base.
+    pub first_round: Vec<Screened>,
+    /// Columns kept as nuisance terms (see [`is_nuisance`]).
+    pub nuisance: Vec<usize>,
+}
+
 /// Forward stepwise selection: the sequence of candidates that each lower BIC by more than
-/// `threshold` given the ones before (at most `max_effects`).
-pub fn stepwise(
-    rows: &[WeakRow],
-    base: Base,
-    threshold: f64,
-    max_effects: usize,
-) -> (Vec<Screened>, Vec<Screened>) {
+/// `threshold` given the ones before (at most `max_effects`). A best candidate that is only a
+/// normal rig tolerance ([`is_nuisance`]) is absorbed as a nuisance term without using a round.
+pub fn stepwise(rows: &[WeakRow], base: Base, threshold: f64, max_effects: usize) -> Stepwise {
     let mut current = base.columns();
     let mut chosen: Vec<Screened> = Vec::new();
     let mut first_round = Vec::new();
+    let mut nuisance = Vec::new();
     let mut pool = candidates(base);
-    for round in 0..max_effects {
+    let mut first = true;
+    while chosen.len() < max_effects {
         let ranked = screen(rows, &current, &pool);
-        if round == 0 {
+        if first {
             first_round = ranked.clone();
+            first = false;
         }
         let Some(best) = ranked.first() else { break };
         if best.delta_bic >= threshold {
@@ -252,7 +278,15 @@ pub fn stepwise(
         current = with_candidate(&current, &best.candidate);
         let name = best.candidate.effect.clone();
         pool.retain(|c| c.effect != name);
-        chosen.push(best.clone());
+        if is_nuisance(best) {
+            nuisance.extend(best.candidate.add.iter().copied());
+        } else {
+            chosen.push(best.clone());
+        }
     }
-    (chosen, first_round)
+    Stepwise {
+        chosen,
+        first_round,
+        nuisance,
+    }
 }

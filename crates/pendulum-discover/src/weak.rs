@@ -55,6 +55,59 @@ pub struct WeakRow {
     pub target: f64,
     /// Regressors: [`TERMS`] then the accel-delay term Ȧ_y sin θ.
     pub x: Vec<f64>,
+    /// Regression weight (inverse residual variance of the row's regime; 1 until
+    /// [`set_weights`] is called).
+    #[serde(default = "one")]
+    pub weight: f64,
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+/// Number of |θ̇| classes per run the residual variance is estimated in.
+const WEIGHT_CLASSES: usize = 3;
+
+/// Feasible weighted least squares: the equation error's noise differs a lot between runs (a
+/// 200 Hz serial capture against a 1000 Hz SD one) and grows with the speed (timestamps jitter,
+/// so the angle error is ~θ̇·δt), so every row is weighted by the inverse variance of
+/// `residuals` (a fit of the whole catalogue, so that a missing effect's torque is not counted
+/// as noise) within its run and |θ̇| class (equal-count classes per run).
+pub fn set_weights(rows: &mut [WeakRow], residuals: &[f64]) {
+    let runs: std::collections::BTreeSet<usize> = rows.iter().map(|r| r.run).collect();
+    for run in runs {
+        let mut idx: Vec<usize> = (0..rows.len())
+            .filter(|&i| {
+                rows[i].run == run
+                    && rows[i].theta_dot_rad_s.is_finite()
+                    && residuals[i].is_finite()
+            })
+            .collect();
+        let classes = if idx.len() >= WEIGHT_CLASSES * 15 {
+            WEIGHT_CLASSES
+        } else {
+            1
+        };
+        if idx.len() < 8 {
+            continue;
+        }
+        idx.sort_by(|&a, &b| {
+            rows[a]
+                .theta_dot_rad_s
+                .abs()
+                .total_cmp(&rows[b].theta_dot_rad_s.abs())
+        });
+        let n = idx.len();
+        for k in 0..classes {
+            let g = &idx[k * n / classes..(k + 1) * n / classes];
+            let m = g.iter().map(|&i| residuals[i]).sum::<f64>() / g.len() as f64;
+            let var = g.iter().map(|&i| (residuals[i] - m).powi(2)).sum::<f64>()
+                / (g.len() as f64 - 1.0);
+            for &i in g {
+                rows[i].weight = 1.0 / var.max(1e-300);
+            }
+        }
+    }
 }
 
 /// Weak-form settings.
@@ -67,8 +120,13 @@ pub struct WeakConfig {
     pub deriv_half_width_s: f64,
     /// Longest forced stretch used per run after t = 0, s.
     pub forced_s: f64,
-    /// Dimensionless |θ̇| below which a sample counts as stuck.
+    /// Dimensionless |θ̇| below which a sample may be stuck.
     pub stuck_theta_dot: f64,
+    /// Dimensionless driving torque |(1 + A_y) sin θ| below which dry friction may hold a slow
+    /// sample at rest (several times any plausible M + T_c/mgl): a window holding such a sample
+    /// is left out, because the friction of a stuck stretch is static and unknown, and its
+    /// gravity torque would otherwise leak into position-dependent terms.
+    pub stick_torque_max: f64,
 }
 
 impl Default for WeakConfig {
@@ -78,6 +136,7 @@ impl Default for WeakConfig {
             deriv_half_width_s: 0.02,
             forced_s: 60.0,
             stuck_theta_dot: 0.02,
+            stick_torque_max: 0.05,
         }
     }
 }
@@ -191,11 +250,13 @@ pub fn weak_rows(run_idx: usize, run: &RunData, al: &Alignment, cfg: &WeakConfig
                 c += 2 * half;
                 continue;
             }
-            let stuck = range
-                .clone()
-                .filter(|&i| (thd[i].unwrap_or(0.0) / w0).abs() < cfg.stuck_theta_dot)
-                .count();
-            if stuck * 10 > 2 * half + 1 {
+            let may_stick = range.clone().any(|i| {
+                let tau = a + i as f64 * dt;
+                let ay = if forced { forcing(tau).0 } else { 0.0 };
+                (thd[i].unwrap_or(0.0) / w0).abs() < cfg.stuck_theta_dot
+                    && ((1.0 + ay) * grid[i].unwrap_or(0.0).sin()).abs() < cfg.stick_torque_max
+            });
+            if may_stick {
                 c += 2 * half;
                 continue;
             }
@@ -280,6 +341,7 @@ pub fn weak_rows(run_idx: usize, run: &RunData, al: &Alignment, cfg: &WeakConfig
                 a_x_meas: run.ax_m_s2.get(ia).copied().unwrap_or(f64::NAN),
                 target,
                 x,
+                weight: 1.0,
             });
             c += 2 * half;
         }
