@@ -10,7 +10,7 @@ pub mod measured;
 pub mod pipeline;
 pub mod run;
 
-pub use align::{align, AlignConfig, Alignment};
+pub use align::{align, AlignConfig, Alignment, AlignmentKind};
 pub use run::{RigParams, Role, RunData};
 
 /// Errors of the processing stages; each names the run or stage and what was expected.
