@@ -111,9 +111,14 @@ pub fn prepare_run(
     }
     let ts: Vec<f64> = idx.iter().map(|&i| w0 * (t[i] - al.t0_s)).collect();
     let mut restarts = Vec::new();
-    if let Some(seg) = window
-        .segment_s
-        .filter(|s| *s > 0.0 && *s < window.window_s)
+    // A free decay's segments span at least two small swings: damping acts over cycles, and
+    // segments shorter than a swing leave it to the restarts' estimated rates (biased fits).
+    let segment_s = if al.is_free() {
+        window.segment_s.map(|s| s.max(2.0 * period_s))
+    } else {
+        window.segment_s
+    };
+    if let Some(seg) = segment_s.filter(|s| *s > 0.0 && *s < window.window_s)
     {
         let ic_cfg = IcConfig::default();
         let mut k = 1;

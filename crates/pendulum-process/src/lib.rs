@@ -3,6 +3,8 @@
 
 pub mod align;
 pub mod fit;
+#[cfg(test)]
+mod free_tests;
 pub mod ic;
 pub mod identify;
 pub mod linalg;
