@@ -221,12 +221,7 @@ fn free_decay_row(
     }
     push("omega0_rad_s", "rad/s", w0, row);
     push("c", "rad", val(FitParam::DryC).unwrap_or(nan), row);
-    push(
-        "small_swing_period_s",
-        "s",
-        std::f64::consts::TAU / w0,
-        row,
-    );
+    push("small_swing_period_s", "s", std::f64::consts::TAU / w0, row);
     // I ω0² = m g l (pivot to centre of mass): with m and l known, torques come out in SI.
     let mgl = rig.m_kg * rig.g_m_s2 * rig.l_m;
     let inertia = mgl / (w0 * w0);
@@ -304,7 +299,9 @@ pub fn read_params(path: &Path, model: Option<&str>) -> Result<FitOutcome, JobEr
                 if given(FitParam::DryC) {
                     spec.params.push(FitParam::CoulombConstant);
                 }
-                spec = spec.free_decay().map_err(|e| bad(format!("model {name}: {e}")))?;
+                spec = spec
+                    .free_decay()
+                    .map_err(|e| bad(format!("model {name}: {e}")))?;
             }
             let params = spec
                 .params

@@ -231,12 +231,10 @@ impl ModelSpec {
                 FitParam::Mu => FitParam::MBearing,
                 FitParam::CoulombConstant => FitParam::DryC,
                 FitParam::EncoderOffset => FitParam::EncoderOffset,
-                other => {
-                    return Err(format!(
-                        "{} cannot be fitted to a free decay (no shaker; inertia absorbed in omega0)",
-                        other.name()
-                    ))
-                }
+                other => return Err(format!(
+                    "{} cannot be fitted to a free decay (no shaker; inertia absorbed in omega0)",
+                    other.name()
+                )),
             };
             if !params.contains(&q) {
                 params.push(q);
@@ -259,7 +257,11 @@ impl ModelSpec {
 
     /// Value of a parameter in `x`, if the model fits it.
     pub fn value_of(&self, p: FitParam, x: &[f64]) -> Option<f64> {
-        self.params.iter().zip(x).find(|(q, _)| **q == p).map(|(_, v)| *v)
+        self.params
+            .iter()
+            .zip(x)
+            .find(|(q, _)| **q == p)
+            .map(|(_, v)| *v)
     }
 
     /// The dimensionless free-decay model for values `x` (excitation off).
@@ -458,10 +460,18 @@ pub fn simulated_steady(
             .collect();
         let t_end = *times.last()?;
         let mut th = Vec::with_capacity(times.len());
-        integrate(model, opts, t_from, y_from, t_end, times.iter().copied(), |s| {
-            th.push(s.theta);
-            ControlFlow::Continue(())
-        })
+        integrate(
+            model,
+            opts,
+            t_from,
+            y_from,
+            t_end,
+            times.iter().copied(),
+            |s| {
+                th.push(s.theta);
+                ControlFlow::Continue(())
+            },
+        )
         .ok()?;
         return Some(crate::measured::classify_free(&th, run.classify.rest_tol));
     }

@@ -88,7 +88,11 @@ fn free_decay_fit_recovers_omega0_and_damping() {
     let ic = estimate_state(&run, al.t0_s, &IcConfig::default()).expect("initial state");
     let steady_cfg = SteadyConfig::default();
     let steady = free_steady_state(&run, al.t0_s, &steady_cfg).expect("steady");
-    assert_eq!(steady.class, SteadyClass::Oscillation, "still swinging at 24 s");
+    assert_eq!(
+        steady.class,
+        SteadyClass::Oscillation,
+        "still swinging at 24 s"
+    );
     let window = Window {
         window_s: 10.0,
         sample_hz: 100.0,

@@ -118,8 +118,7 @@ pub fn prepare_run(
     } else {
         window.segment_s
     };
-    if let Some(seg) = segment_s.filter(|s| *s > 0.0 && *s < window.window_s)
-    {
+    if let Some(seg) = segment_s.filter(|s| *s > 0.0 && *s < window.window_s) {
         let ic_cfg = IcConfig::default();
         let mut k = 1;
         loop {
@@ -392,11 +391,7 @@ pub fn identify(
         .collect();
     Ok(FitOutcome {
         params: best_x[..n].to_vec(),
-        f_obj: if free {
-            eval.f_obj
-        } else {
-            res.best_cost
-        },
+        f_obj: if free { eval.f_obj } else { res.best_cost },
         e_theta: eval.e_theta,
         generations: res.generations,
         evaluations: res.evaluations,
