@@ -647,7 +647,7 @@ pub fn write_outputs(
             {
                 let _ = writeln!(
                     text,
-                    "  excitation off; t = 0 at each run's first turning point; not separable: {}",
+                    "  excitation off; t = 0 at each run's first turning point; {}",
                     not_separable(&r.rig)
                 );
             }

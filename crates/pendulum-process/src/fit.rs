@@ -231,10 +231,12 @@ impl ModelSpec {
                 FitParam::Mu => FitParam::MBearing,
                 FitParam::CoulombConstant => FitParam::DryC,
                 FitParam::EncoderOffset => FitParam::EncoderOffset,
-                other => return Err(format!(
+                other => {
+                    return Err(format!(
                     "{} cannot be fitted to a free decay (no shaker; inertia absorbed in omega0)",
                     other.name()
-                )),
+                ))
+                }
             };
             if !params.contains(&q) {
                 params.push(q);
