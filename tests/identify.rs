@@ -48,7 +48,7 @@ fn identify(dir: &Path, out: &Path, model: &str) -> pendulum_jobs::outputs::Outp
     .unwrap()
 }
 
-fn column_f64(path: &Path, name: &str) -> Vec<f64> {
+pub(crate) fn column_f64(path: &Path, name: &str) -> Vec<f64> {
     use arrow_array::Float64Array;
     use parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
     let f = std::fs::File::open(path).unwrap();
@@ -73,7 +73,7 @@ fn column_f64(path: &Path, name: &str) -> Vec<f64> {
     out
 }
 
-fn column_str(path: &Path, name: &str) -> Vec<String> {
+pub(crate) fn column_str(path: &Path, name: &str) -> Vec<String> {
     use arrow_array::{Array, StringArray};
     use parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
     let f = std::fs::File::open(path).unwrap();

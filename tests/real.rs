@@ -15,6 +15,8 @@ use pendulum_explain::{
 };
 use pendulum_jobs::{ingest, runs};
 
+use crate::identify::{column_f64, column_str};
+
 /// The authors' arm (their EstimatedParameters_SinglePendulum.mat): m1, a1, I1 about the
 /// centre of mass, viscous k1.
 const M1_KG: f64 = 0.1476;
@@ -314,4 +316,202 @@ fn multiarm_discover_command_names_dry_friction() {
         "dry friction not accepted: {dry}"
     );
     assert!(out.join("diagnosis.parquet").is_file() && out.join("report.md").is_file());
+}
+
+/// The MultiArm campaign with its roles set per run (the rest as in [`campaign_toml`]).
+fn campaign_with_roles(data: &Path, small: &str, large: &str) -> String {
+    campaign_toml(data)
+        .replace("role = \"identify\"\n", "")
+        .replace(
+            "id = \"small\"\n",
+            &format!("id = \"small\"\nrole = \"{small}\"\n"),
+        )
+        .replace(
+            "id = \"large\"\n",
+            &format!("id = \"large\"\nrole = \"{large}\"\n"),
+        )
+}
+
+fn pendulum(args: &[&str], paths: &[&Path]) -> String {
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_pendulum"))
+        .args(args)
+        .args(paths)
+        .output()
+        .expect("run pendulum");
+    let text = String::from_utf8_lossy(&o.stdout).into_owned();
+    assert!(
+        o.status.success(),
+        "pendulum {args:?} failed:\n{text}\n{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    print!("{text}");
+    text
+}
+
+/// E_θ per fitted sample (10 s at 100 Hz) relative to the run's first amplitude.
+fn relative_e_theta(runs: &Path, id: &str) -> f64 {
+    let ids = column_str(runs, "run_id");
+    let k = ids.iter().position(|r| r == id).expect("run row");
+    column_f64(runs, "e_theta")[k] / 1000.0 / column_f64(runs, "theta0_est")[k].abs()
+}
+
+/// Issue 7, item 2: `pendulum identify` on the MultiArm campaign (no shaker, a physical
+/// pendulum) aligns each run as a free decay, fits ω0 and the damping per unit inertia with the
+/// excitation off, and says what it could not separate; ω0 agrees with the swing period, the
+/// small decay's fitted dry friction gives the ≈ 0.0104 rad per cycle it loses, and
+/// `pendulum validate` takes the free-decay params file.
+#[test]
+fn multiarm_identify_free_decay() {
+    let data = data_dir();
+    let tmp = tempfile::tempdir().expect("temp dir");
+    // The repository's campaign (its files are relative to it), unless the data live elsewhere.
+    let camp = if std::env::var_os("PENDULUM_MULTIARM_DIR").is_none() {
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("campaigns/multiarm")
+    } else {
+        let c = tmp.path().join("campaign");
+        std::fs::create_dir_all(&c).expect("campaign dir");
+        std::fs::write(c.join("campaign.toml"), campaign_toml(&data)).expect("write campaign");
+        c
+    };
+
+    // --- Both decays fitted together (one arm: one ω0). ---
+    let joint = tmp.path().join("joint");
+    let text = pendulum(&["identify", "--quiet", "--out"], &[&joint, &camp]);
+    assert!(
+        text.contains("free decay") && text.contains("not separable"),
+        "{text}"
+    );
+    let (params, runs) = (joint.join("params.parquet"), joint.join("runs.parquet"));
+    assert_eq!(column_str(&params, "excitation"), ["none"]);
+    assert!(!column_str(&params, "not_separable")[0].is_empty());
+    for unknown in ["a", "b", "mu", "R", "omega", "omega_hz", "crank_r_m"] {
+        assert!(column_f64(&params, unknown)[0].is_nan(), "{unknown}");
+    }
+    let w0 = column_f64(&params, "omega0_rad_s")[0];
+    let ids = column_str(&runs, "run_id");
+    assert_eq!(column_str(&runs, "alignment"), ["free_decay", "free_decay"]);
+    assert!(column_f64(&runs, "omega_hz").iter().all(|w| w.is_nan()));
+    let w_est = column_f64(&runs, "omega0_est_rad_s");
+    let est = |id: &str| w_est[ids.iter().position(|r| r == id).expect("row")];
+    // The large swings dominate E_θ: ω0 is theirs; the small decay's period-derived value
+    // (its smallest swings are faster than a pendulum's, see discover) within 1.5 %.
+    assert!(
+        (w0 - est("large")).abs() < 0.003 * w0,
+        "{w0} vs {}",
+        est("large")
+    );
+    assert!(
+        (w0 - est("small")).abs() < 0.015 * w0,
+        "{w0} vs {}",
+        est("small")
+    );
+    // The authors' arm: sqrt(m g a / I_pivot) = 8.01 rad/s.
+    assert!((w0 - authors().omega_n_rad_s).abs() < 0.005 * w0, "{w0}");
+    assert_eq!(
+        column_str(&runs, "measured_steady"),
+        column_str(&runs, "simulated_steady")
+    );
+    for id in ["small", "large"] {
+        let rel = relative_e_theta(&runs, id);
+        assert!(
+            rel < 0.02,
+            "run {id}: E_θ per sample is {rel} of the amplitude"
+        );
+    }
+    // With m and l given, the pivot inertia follows: the authors' I1 + m1 a1² within 2 %.
+    let inertia = column_f64(&params, "inertia_pivot_kg_m2")[0];
+    let i_pivot = I1_CM + M1_KG * A1_M * A1_M;
+    assert!((inertia - i_pivot).abs() < 0.02 * i_pivot, "{inertia}");
+
+    // --- The small decay alone (the large one validates): its dry friction. ---
+    let split = tmp.path().join("split");
+    std::fs::create_dir_all(&split).expect("split dir");
+    std::fs::write(
+        split.join("campaign.toml"),
+        campaign_with_roles(&data, "identify", "validate"),
+    )
+    .expect("write campaign");
+    let out = tmp.path().join("small");
+    pendulum(&["identify", "--quiet", "--out"], &[&out, &split]);
+    let params = out.join("params.parquet");
+    let runs = out.join("runs.parquet");
+    let w_small = column_f64(&params, "omega0_rad_s")[0];
+    let ids = column_str(&runs, "run_id");
+    let k = ids.iter().position(|r| r == "small").expect("row");
+    let w_est = column_f64(&runs, "omega0_est_rad_s")[k];
+    assert!(
+        (w_small - w_est).abs() < 0.015 * w_est,
+        "{w_small} vs {w_est}"
+    );
+    assert!(relative_e_theta(&runs, "small") < 0.01);
+    let (beta, alpha, m) = (
+        column_f64(&params, "beta")[0],
+        column_f64(&params, "alpha")[0],
+        column_f64(&params, "M")[0],
+    );
+    // The loss per cycle the fitted terms give at the decay's median amplitude, next to the
+    // free-decay analysis' envelope (measured) and the ≈ 0.0104 rad it shows.
+    let small_data = runs::load_runs(&split)
+        .expect("runs")
+        .into_iter()
+        .find(|r| r.id == "small")
+        .expect("small run");
+    let env =
+        pendulum_explain::envelope(&small_data.enc_t_s, &small_data.theta_rad).expect("envelope");
+    let mut amps: Vec<f64> = env
+        .rows
+        .iter()
+        .filter_map(|r| r.mid_amplitude_rad)
+        .collect();
+    amps.sort_by(f64::total_cmp);
+    let mut losses: Vec<f64> = env
+        .rows
+        .iter()
+        .filter_map(|r| r.loss_per_cycle_rad)
+        .collect();
+    losses.sort_by(f64::total_cmp);
+    let (a_mid, measured) = (amps[amps.len() / 2], losses[losses.len() / 2]);
+    let dry = m * Term::CoulombBearing.loss_per_cycle(a_mid);
+    let model = dry
+        + beta * Term::ViscousLinear.loss_per_cycle(a_mid)
+        + alpha * Term::ViscousQuadratic.loss_per_cycle(a_mid);
+    println!(
+        "small: omega0 {w_small:.4} beta {beta:.3e} alpha {alpha:.3e} M {m:.3e}; loss/cycle at \
+         A = {a_mid:.4}: model {model:.5} (dry {dry:.5}), measured {measured:.5}"
+    );
+    for target in [LOSS_PER_CYCLE, measured] {
+        assert!(
+            (model - target).abs() < 0.15 * target,
+            "model loss per cycle {model} vs {target}"
+        );
+    }
+    assert!(dry > 0.7 * model, "dry friction {dry} of {model}");
+    // The validate run was scored with the small decay's damping.
+    let e = column_f64(&runs, "e_theta")[ids.iter().position(|r| r == "large").expect("row")];
+    assert!(e.is_finite() && e > 0.0, "{e}");
+
+    // --- `pendulum validate` with the joint fit's params on both decays. ---
+    let val = tmp.path().join("val");
+    std::fs::create_dir_all(&val).expect("val dir");
+    std::fs::write(
+        val.join("campaign.toml"),
+        campaign_with_roles(&data, "validate", "validate"),
+    )
+    .expect("write campaign");
+    let vout = tmp.path().join("vout");
+    let text = pendulum(
+        &["validate", "--params"],
+        &[
+            &joint.join("params.parquet"),
+            Path::new("--out"),
+            &vout,
+            &val,
+        ],
+    );
+    assert!(text.contains("free decay"), "{text}");
+    let vruns = vout.join("runs.parquet");
+    for id in ["small", "large"] {
+        let rel = relative_e_theta(&vruns, id);
+        assert!(rel < 0.02, "validate run {id}: {rel}");
+    }
 }

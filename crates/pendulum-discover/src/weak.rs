@@ -394,6 +394,8 @@ mod tests {
             ax_m_s2: vec![],
         };
         let al = Alignment {
+            kind: pendulum_process::align::AlignmentKind::Shaker,
+            omega0_est_rad_s: f64::NAN,
             shaker_start_s: 30.0,
             free_segment_s: (0.0, 19.9),
             t0_s: 25.0,

@@ -758,6 +758,20 @@ fn half_period_factor(a: f64) -> f64 {
     2.0 * ellip_k((0.5 * a).sin())
 }
 
+/// The small-swing natural frequency ω_n, rad/s, from successive turning points: the median over
+/// half swings of (exact pendulum half period at that swing's amplitude, in units of 1/ω_n) /
+/// (measured half period), so large swings do not bias it. NaN with fewer than two points.
+pub fn omega_n_estimate(tps: &[TurningPoint]) -> f64 {
+    let mut w_est: Vec<f64> = tps
+        .windows(2)
+        .map(|w| {
+            let a = 0.5 * (w[0].theta_rad - w[1].theta_rad).abs();
+            half_period_factor(a) / (w[1].t_s - w[0].t_s)
+        })
+        .collect();
+    median(&mut w_est)
+}
+
 // ---------------------------------------------------------------------------------------------
 // Envelope
 // ---------------------------------------------------------------------------------------------
@@ -1567,14 +1581,7 @@ pub fn diagnose_decay(
     let t_split = tps[k_split].t_s;
 
     // Initial guesses: ω_n from the half periods with the exact pendulum's amplitude factor.
-    let mut w_est: Vec<f64> = tps
-        .windows(2)
-        .map(|w| {
-            let a = 0.5 * (w[0].theta_rad - w[1].theta_rad).abs();
-            half_period_factor(a) / (w[1].t_s - w[0].t_s)
-        })
-        .collect();
-    let omega0 = median(&mut w_est);
+    let omega0 = omega_n_estimate(&tps);
     let init_terms = |terms: &[Term]| -> Vec<f64> {
         let pts: Vec<(f64, f64)> = env
             .rows

@@ -16,7 +16,7 @@ use pendulum_plot::{Figure, Panel, Series, SeriesStyle};
 use pendulum_process::fit::{FitParam, ModelSpec};
 use pendulum_process::identify::{FitOutcome, RunFit};
 use pendulum_process::pipeline::Context;
-use pendulum_process::Role;
+use pendulum_process::{RigParams, Role};
 use pendulum_report::{Column, ColumnData, TableOptions};
 
 use crate::identify::residuals_of;
@@ -67,8 +67,25 @@ fn ints(name: &str, v: Vec<i64>) -> Column {
     Column::new(name, ColumnData::I64(v))
 }
 
+/// Which quantities a free decay's fit could not separate (the `not_separable` column and the
+/// printed summary): θ(t) gives ω0 and torques per unit inertia only; the campaign's m and l
+/// (pivot to centre of mass), when given, turn them into an inertia and SI torques.
+pub fn not_separable(rig: &RigParams) -> String {
+    if rig.m_kg.is_finite() && rig.l_m.is_finite() {
+        "m and l from the campaign give I = m g l/omega0^2 (pivot), hence SI torques; J = I - m l^2 \
+         only as good as m and l; mu and r_b not separable (only M = mu r_b m g/(I omega0^2))"
+            .into()
+    } else {
+        "m, l, J not separable: only omega0 and damping/inertia ratios (beta = viscous/(I omega0), \
+         alpha = quadratic/I, M and c = dry torque/(I omega0^2)); give m_kg and l_m for SI torques"
+            .into()
+    }
+}
+
 /// Rows of params.parquet: one per fitted (or given) model, dimensionless values for the first
-/// identify run's rig and crank speed.
+/// identify run's rig and crank speed. A free-decay model (excitation off) has its fitted ω0 and
+/// ratios; the crank's columns and the SI damping (a, b, μ) are NaN, and its `not_separable`
+/// says why; with the campaign's m and l it also has the pivot inertia and SI torques.
 pub fn params_columns(ctx: &Context, fits: &[FitOutcome]) -> Vec<Column> {
     let first = ctx
         .runs
@@ -76,9 +93,11 @@ pub fn params_columns(ctx: &Context, fits: &[FitOutcome]) -> Vec<Column> {
         .find(|r| r.role == Role::Identify)
         .or(ctx.runs.first());
     let mut model = Vec::new();
+    let (mut excitation, mut separable) = (Vec::new(), Vec::new());
     let mut cols: Vec<(String, String, Vec<f64>)> = Vec::new();
     let mut push = |name: &str, unit: &str, v: f64, row: usize| {
         if let Some(c) = cols.iter_mut().find(|c| c.0 == name) {
+            c.2.resize(row, f64::NAN);
             c.2.push(v);
         } else {
             let mut vals = vec![f64::NAN; row];
@@ -97,6 +116,14 @@ pub fn params_columns(ctx: &Context, fits: &[FitOutcome]) -> Vec<Column> {
             ),
             None => continue,
         };
+        if fit.spec.is_free_decay() {
+            excitation.push("none".to_string());
+            separable.push(not_separable(&rig));
+            free_decay_row(&mut push, fit, &rig, row);
+            continue;
+        }
+        excitation.push("crank".to_string());
+        separable.push(String::new());
         let phys = fit.spec.physical(&rig, omega_hz, &fit.params);
         let d = phys.to_dimensionless();
         push("a", "kg/m", phys.a_kg_m, row);
@@ -123,24 +150,12 @@ pub fn params_columns(ctx: &Context, fits: &[FitOutcome]) -> Vec<Column> {
             };
             push(p.name(), p.unit(), v, row);
         }
-        push("f_obj", "rad", fit.f_obj, row);
-        push("e_theta", "rad", fit.e_theta, row);
-        push("n_runs", "1", fit.runs.len() as f64, row);
-        push("generations", "1", fit.generations as f64, row);
-        push("evaluations", "1", fit.evaluations as f64, row);
-        push("abandoned", "1", fit.abandoned as f64, row);
-        push("wall_s", "s", fit.wall_s, row);
-        push("seed", "1", fit.seed as f64, row);
-        push("np", "1", fit.np as f64, row);
-        push(
-            "polished_f_obj",
-            "rad",
-            fit.polished.as_ref().map_or(f64::NAN, |p| p.1),
-            row,
-        );
+        fit_stats(&mut push, fit, row);
     }
+    let n_rows = model.len();
     let mut out = vec![strs("model", model)];
-    for (name, unit, vals) in cols {
+    for (name, unit, mut vals) in cols {
+        vals.resize(n_rows, f64::NAN);
         let col = match name.as_str() {
             "n_runs" | "generations" | "evaluations" | "abandoned" | "seed" | "np" => {
                 ints(&name, vals.iter().map(|v| *v as i64).collect())
@@ -149,7 +164,87 @@ pub fn params_columns(ctx: &Context, fits: &[FitOutcome]) -> Vec<Column> {
         };
         out.push(col);
     }
+    out.push(strs("excitation", excitation));
+    out.push(strs("not_separable", separable));
     out
+}
+
+/// The columns every row has: the fit's objective and budget.
+fn fit_stats(push: &mut impl FnMut(&str, &str, f64, usize), fit: &FitOutcome, row: usize) {
+    push("f_obj", "rad", fit.f_obj, row);
+    push("e_theta", "rad", fit.e_theta, row);
+    push("n_runs", "1", fit.runs.len() as f64, row);
+    push("generations", "1", fit.generations as f64, row);
+    push("evaluations", "1", fit.evaluations as f64, row);
+    push("abandoned", "1", fit.abandoned as f64, row);
+    push("wall_s", "s", fit.wall_s, row);
+    push("seed", "1", fit.seed as f64, row);
+    push("np", "1", fit.np as f64, row);
+    push(
+        "polished_f_obj",
+        "rad",
+        fit.polished.as_ref().map_or(f64::NAN, |p| p.1),
+        row,
+    );
+}
+
+/// A free-decay row: the same columns (crank and SI damping NaN: no shaker, not separable),
+/// the fitted ratios, and the pivot inertia and SI torques when the campaign gives m and l.
+fn free_decay_row(
+    push: &mut impl FnMut(&str, &str, f64, usize),
+    fit: &FitOutcome,
+    rig: &RigParams,
+    row: usize,
+) {
+    let val = |p: FitParam| fit.spec.value_of(p, &fit.params);
+    let term = |p: FitParam| val(p).unwrap_or(0.0);
+    let w0 = val(FitParam::Omega0).unwrap_or(f64::NAN);
+    let nan = f64::NAN;
+    push("a", "kg/m", nan, row);
+    push("b", "N·s/m", nan, row);
+    push("mu", "1", nan, row);
+    push("alpha", "1", term(FitParam::Alpha), row);
+    push("beta", "1", term(FitParam::Beta), row);
+    push("M", "1", term(FitParam::MBearing), row);
+    push("R", "1", nan, row);
+    push("lambda", "1", nan, row);
+    push("omega", "1", nan, row);
+    push("m_kg", "kg", rig.m_kg, row);
+    push("l_m", "m", rig.l_m, row);
+    push("crank_r_m", "m", nan, row);
+    push("rod_L_m", "m", nan, row);
+    push("r_b_m", "m", rig.r_b_m, row);
+    push("g_m_s2", "m/s²", rig.g_m_s2, row);
+    push("omega_hz", "Hz", nan, row);
+    for p in ALL_EFFECT_PARAMS {
+        push(p.name(), p.unit(), val(p).unwrap_or(nan), row);
+    }
+    push("omega0_rad_s", "rad/s", w0, row);
+    push("c", "rad", val(FitParam::DryC).unwrap_or(nan), row);
+    push("small_swing_period_s", "s", std::f64::consts::TAU / w0, row);
+    // I ω0² = m g l (pivot to centre of mass): with m and l known, torques come out in SI.
+    let mgl = rig.m_kg * rig.g_m_s2 * rig.l_m;
+    let inertia = mgl / (w0 * w0);
+    push("inertia_pivot_kg_m2", "kg·m²", inertia, row);
+    push(
+        "viscous_n_m_s",
+        "N·m·s",
+        term(FitParam::Beta) * w0 * inertia,
+        row,
+    );
+    push(
+        "quadratic_n_m_s2",
+        "N·m·s²",
+        term(FitParam::Alpha) * inertia,
+        row,
+    );
+    push(
+        "dry_torque_n_m",
+        "N·m",
+        (term(FitParam::DryC) + term(FitParam::MBearing)) * mgl,
+        row,
+    );
+    fit_stats(push, fit, row);
 }
 
 /// Reads one model back from a params.parquet (the first row, or the row named `model`).
@@ -193,10 +288,20 @@ pub fn read_params(path: &Path, model: Option<&str>) -> Result<FitOutcome, JobEr
                 params: base.params.clone(),
                 fixed: Effects::default(),
             };
+            let given = |p: FitParam| get(p.name()).is_some_and(|v| !v.is_nan());
             for p in ALL_EFFECT_PARAMS {
-                if get(p.name()).is_some_and(|v| !v.is_nan()) {
+                if given(p) {
                     spec.params.push(p);
                 }
+            }
+            // A free-decay row (it has ω0): the same model in identifiable terms.
+            if given(FitParam::Omega0) {
+                if given(FitParam::DryC) {
+                    spec.params.push(FitParam::CoulombConstant);
+                }
+                spec = spec
+                    .free_decay()
+                    .map_err(|e| bad(format!("model {name}: {e}")))?;
             }
             let params = spec
                 .params
@@ -267,7 +372,16 @@ pub fn write_outputs(
     // params.parquet
     if !models.is_empty() {
         let p = out.join("params.parquet");
-        opts.write(&p, &params_columns(ctx, &models))?;
+        let mut o = opts.clone();
+        if models.iter().any(|m| m.spec.is_free_decay()) {
+            o = o.meta(
+                "free_decay",
+                "excitation off; omega0 (rad/s) and damping per unit inertia in t = omega0 tau \
+                 (beta, alpha, M, c) are fitted; a, b, mu and the crank columns are NaN: see \
+                 column not_separable",
+            );
+        }
+        o.write(&p, &params_columns(ctx, &models))?;
         tables.push(p);
     }
 
@@ -282,7 +396,8 @@ pub fn write_outputs(
                     .collect()
             })
             .unwrap_or_default();
-        let mut c: Vec<Vec<f64>> = vec![Vec::new(); 14];
+        let mut c: Vec<Vec<f64>> = vec![Vec::new(); 15];
+        let mut kinds = Vec::new();
         let (mut ids, mut roles, mut meas, mut sim, mut agree) =
             (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
         let mut meas_p = Vec::new();
@@ -292,6 +407,7 @@ pub fn write_outputs(
             roles.push(r.role.as_str().to_string());
             let al = ctx.alignments.get(&r.id);
             let ic = ctx.initial.get(&r.id);
+            kinds.push(al.map_or("-", |a| a.kind.as_str()).to_string());
             let vals = [
                 r.rig.omega_hz.unwrap_or(f64::NAN),
                 al.map_or(f64::NAN, |a| a.omega_hz),
@@ -314,6 +430,7 @@ pub fn write_outputs(
                     .iter()
                     .find(|f| f.id == r.id)
                     .map_or(f64::NAN, |f| f.e_theta),
+                al.map_or(f64::NAN, |a| a.omega0_est_rad_s),
             ];
             for (col, v) in c.iter_mut().zip(vals) {
                 col.push(v);
@@ -342,8 +459,13 @@ pub fn write_outputs(
             ("theta_dot0_est", "rad/s"),
             ("hanging_theta", "rad"),
             ("e_theta", "rad"),
+            ("omega0_est_rad_s", "rad/s"),
         ];
-        let mut cols = vec![strs("run_id", ids), strs("role", roles)];
+        let mut cols = vec![
+            strs("run_id", ids),
+            strs("role", roles),
+            strs("alignment", kinds),
+        ];
         for ((n, u), v) in names.iter().zip(c) {
             cols.push(f64s(n, u, v));
         }
@@ -372,11 +494,15 @@ pub fn write_outputs(
     for m in &models {
         let val = validation_of(ctx, &m.spec.name);
         for rf in m.runs.iter().chain(val.unwrap_or(&[])) {
-            let w0 = ctx
-                .runs
-                .iter()
-                .find(|r| r.id == rf.id)
-                .map_or(1.0, |r| r.rig.omega0_rad_s());
+            // The unit of the fitted rates: a free decay's period-derived ω0, else sqrt(g/l).
+            let w0 = match ctx.alignments.get(&rf.id) {
+                Some(a) if a.is_free() => a.omega0_est_rad_s,
+                _ => ctx
+                    .runs
+                    .iter()
+                    .find(|r| r.id == rf.id)
+                    .map_or(1.0, |r| r.rig.omega0_rad_s()),
+            };
             ic_run.push(rf.id.clone());
             ic_model.push(m.spec.name.clone());
             ic_role.push(rf.role.as_str().to_string());
@@ -419,7 +545,12 @@ pub fn write_outputs(
                 m.spec.name.replace('+', "_"),
                 id
             ));
-            history_plot(&png, &id, &m.spec.name, role, &s)?;
+            let x_label = if m.spec.is_free_decay() {
+                "time from the first turning point (s)"
+            } else {
+                "time from the first at-speed peak (s)"
+            };
+            history_plot(&png, &id, &m.spec.name, role, &s, x_label)?;
             plots.push(png);
         }
         if m.convergence.len() > 1 {
@@ -489,7 +620,13 @@ pub fn write_outputs(
         out.display()
     );
     for m in &models {
-        let _ = write!(text, "model {:<28}", m.spec.name);
+        let free = m.spec.is_free_decay();
+        let label = if free {
+            format!("{} (free decay)", m.spec.name)
+        } else {
+            m.spec.name.clone()
+        };
+        let _ = write!(text, "model {label:<28}");
         for (p, v) in m.spec.params.iter().zip(&m.params) {
             let _ = write!(text, " {}={:.5}", p.name(), v);
         }
@@ -500,6 +637,20 @@ pub fn write_outputs(
         );
         if let Some((x, f, n)) = &m.polished {
             let _ = writeln!(text, "  polished: {:?} f_obj={f:.4} ({n} evals)", x);
+        }
+        if free {
+            if let Some(r) = ctx
+                .runs
+                .iter()
+                .find(|r| r.role == Role::Identify)
+                .or(ctx.runs.first())
+            {
+                let _ = writeln!(
+                    text,
+                    "  excitation off; t = 0 at each run's first turning point; {}",
+                    not_separable(&r.rig)
+                );
+            }
         }
         for rf in m
             .runs
@@ -540,6 +691,7 @@ fn history_plot(
     model: &str,
     role: Role,
     s: &pendulum_process::identify::ResidualSeries,
+    x_label: &str,
 ) -> Result<(), JobError> {
     let series = |label: &str, y: &[f64], color: usize| Series {
         label: label.into(),
@@ -553,7 +705,7 @@ fn history_plot(
         panels: vec![
             Panel {
                 title: "Angle".into(),
-                x_label: "time from the first at-speed peak (s)".into(),
+                x_label: x_label.into(),
                 y_label: "θ (rad)".into(),
                 series: vec![
                     series("measured", &s.theta_meas, 0),
@@ -563,7 +715,7 @@ fn history_plot(
             },
             Panel {
                 title: "Angular velocity".into(),
-                x_label: "time from the first at-speed peak (s)".into(),
+                x_label: x_label.into(),
                 y_label: "dθ/dt (rad/s)".into(),
                 series: vec![
                     series("measured", &s.theta_dot_meas, 0),

@@ -8,6 +8,13 @@
 //! a_z = c0 + G·r(2πΩ)²·f''(2πΩ(t − t_p)) refines (c0, G, Ω, t_p) and gives their covariance;
 //! (4) walking back peak by peak from the window, the earliest peak from which every cycle carries
 //! at least `at_speed_fraction` of the fitted amplitude is t = 0.
+//!
+//! A run with no shaker (no `omega_hz`: a free decay) is not an error: it gets a
+//! [`AlignmentKind::FreeDecay`] alignment with the excitation off. Its t = 0 is the recording's
+//! first turning point (θ̇ = 0 there, so the initial state is well determined and a hand release
+//! or hold before it is skipped), and the time unit of its fit is the small-swing natural
+//! frequency estimated from the swing periods (`pendulum_explain::omega_n_estimate`), since
+//! sqrt(g/l) is wrong for a physical pendulum and m, l may be unknown.
 
 use pendulum_model::excitation::crank_f2;
 use serde::{Deserialize, Serialize};
@@ -75,9 +82,36 @@ impl AlignConfig {
     }
 }
 
+/// Whether a run was aligned to its shaker or is a free decay (excitation off).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum AlignmentKind {
+    /// t = 0 at the first positive acceleration peak at speed (the study's convention).
+    #[default]
+    Shaker,
+    /// No base motion: t = 0 at the first turning point; the crank fields are NaN.
+    FreeDecay,
+}
+
+impl AlignmentKind {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            AlignmentKind::Shaker => "shaker",
+            AlignmentKind::FreeDecay => "free_decay",
+        }
+    }
+}
+
 /// Where a run's forced motion starts and how its crank turns.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Alignment {
+    /// Shaker-aligned or free decay.
+    #[serde(default)]
+    pub kind: AlignmentKind,
+    /// Free decay: the small-swing natural frequency from the swing periods, rad/s: the time
+    /// unit of the fit until ω0 is fitted. NaN for shaker runs (their unit is sqrt(g/l)).
+    #[serde(default = "nan")]
+    pub omega0_est_rad_s: f64,
     /// Detected shaker start, s since the first sample.
     pub shaker_start_s: f64,
     /// The free-motion segment [start, end] before the shaker (a free decay), s.
@@ -97,6 +131,54 @@ pub struct Alignment {
     pub residual_rms_m_s2: f64,
     /// The window the crank model was fitted on, s.
     pub fit_window_s: (f64, f64),
+}
+
+fn nan() -> f64 {
+    f64::NAN
+}
+
+impl Alignment {
+    /// A free decay (excitation off).
+    pub fn is_free(&self) -> bool {
+        self.kind == AlignmentKind::FreeDecay
+    }
+}
+
+/// The alignment of a run with no shaker (see the module docs).
+pub fn align_free_decay(run: &RunData) -> Result<Alignment, ProcessError> {
+    let fail = |reason: String| ProcessError::Align {
+        run: run.id.clone(),
+        reason,
+    };
+    let (t, th) = (&run.enc_t_s, &run.theta_rad);
+    let tps = pendulum_explain::turning_points(t, th);
+    if tps.len() < 3 {
+        return Err(fail(format!(
+            "no shaker (no omega_hz) and only {} turning points: a free decay needs a few swings",
+            tps.len()
+        )));
+    }
+    let w0 = pendulum_explain::omega_n_estimate(&tps);
+    if !(w0.is_finite() && w0 > 0.0) {
+        return Err(fail(format!(
+            "free decay: no natural frequency from the swing periods ({w0})"
+        )));
+    }
+    let (first, last) = (t[0], t[t.len() - 1]);
+    Ok(Alignment {
+        kind: AlignmentKind::FreeDecay,
+        omega0_est_rad_s: w0,
+        shaker_start_s: f64::NAN,
+        free_segment_s: (first, last),
+        t0_s: tps[0].t_s,
+        t0_sigma_s: f64::NAN,
+        omega_hz: f64::NAN,
+        omega_sigma_hz: f64::NAN,
+        accel_gain: f64::NAN,
+        az_offset_m_s2: f64::NAN,
+        residual_rms_m_s2: f64::NAN,
+        fit_window_s: (f64::NAN, f64::NAN),
+    })
 }
 
 fn f3(phi: f64, lambda: f64) -> f64 {
@@ -124,10 +206,9 @@ pub fn align(run: &RunData, cfg: &AlignConfig) -> Result<Alignment, ProcessError
         run: run.id.clone(),
         reason,
     };
-    let omega_set = run
-        .rig
-        .omega_hz
-        .ok_or_else(|| fail("the campaign gives no omega_hz: no shaker to align to".into()))?;
+    let Some(omega_set) = run.rig.omega_hz else {
+        return align_free_decay(run);
+    };
     let (t, az) = (&run.acc_t_s, &run.az_m_s2);
     if t.len() < 50 {
         return Err(fail(format!("only {} accelerometer samples", t.len())));
@@ -312,6 +393,8 @@ pub fn align(run: &RunData, cfg: &AlignConfig) -> Result<Alignment, ProcessError
     let d_om = -k / (omega * omega);
     let var = cov[3 * 4 + 3] + d_om * d_om * cov[2 * 4 + 2] + 2.0 * d_om * cov[2 * 4 + 3];
     Ok(Alignment {
+        kind: AlignmentKind::Shaker,
+        omega0_est_rad_s: f64::NAN,
         shaker_start_s,
         free_segment_s: (t[0], (shaker_start_s - 0.05).max(t[0])),
         t0_s,

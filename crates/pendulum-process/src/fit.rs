@@ -7,6 +7,14 @@
 //! f = Σ_j E_j·(κ if class_j differs else 1). Since every factor is ≥ 1, a partial sum of the E_j
 //! is a lower bound of f, which is what lets a trial be abandoned as soon as it exceeds its target
 //! (the selection is then the same as the plain algorithm's).
+//!
+//! Free decays (runs aligned as [`crate::AlignmentKind::FreeDecay`]) go through the same objective
+//! with the excitation off. m, l and the inertia are not separable from θ(t) alone, so their
+//! model is fitted in identifiable terms (`ModelSpec::free_decay`): the small-swing natural
+//! frequency ω0 (rad/s) and the dimensionless damping of `pendulum_model::Dimensionless` in
+//! t = ω0·τ (β, α, M, c: torques per unit inertia over ω0 or ω0²), plus the swing's centre. A
+//! run's times are made dimensionless with its period-derived ω0 estimate; a trial ω0 rescales
+//! them by ω0/ω0_est (and velocities by the inverse).
 
 use std::ops::ControlFlow;
 
@@ -45,6 +53,16 @@ pub enum FitParam {
     AccelDelay,
     /// `speed_drift` dΩ/dτ, Hz/s.
     SpeedDrift,
+    /// Free decay: small-swing natural frequency ω0, rad/s (the unit of dimensionless time).
+    Omega0,
+    /// Free decay: β = viscous torque/(I ω0 θ̇) (`viscous_linear` per unit inertia).
+    Beta,
+    /// Free decay: α = quadratic drag torque/(I θ̇²) (`viscous_quadratic`).
+    Alpha,
+    /// Free decay: M = μ r_b m g/(I ω0²) (`coulomb_bearing`, point-mass load |θ'² + cos θ|).
+    MBearing,
+    /// Free decay: c = T_c/(I ω0²) (`coulomb_constant`: the dead band's half-width, rad).
+    DryC,
 }
 
 impl FitParam {
@@ -62,6 +80,11 @@ impl FitParam {
             FitParam::EncoderOffset => "encoder_offset.theta_off",
             FitParam::AccelDelay => "accel_delay.Delta",
             FitParam::SpeedDrift => "speed_drift.dOmega_dtau",
+            FitParam::Omega0 => "omega0_rad_s",
+            FitParam::Beta => "beta",
+            FitParam::Alpha => "alpha",
+            FitParam::MBearing => "M",
+            FitParam::DryC => "c",
         }
     }
 
@@ -77,6 +100,10 @@ impl FitParam {
             }
             FitParam::AccelDelay => "s",
             FitParam::SpeedDrift => "Hz/s",
+            FitParam::Omega0 => "rad/s",
+            FitParam::Beta | FitParam::MBearing => "1",
+            FitParam::Alpha => "1/rad",
+            FitParam::DryC => "rad",
         }
     }
 
@@ -94,6 +121,11 @@ impl FitParam {
             FitParam::EncoderOffset => (-0.2, 0.2),
             FitParam::AccelDelay => (-0.05, 0.05),
             FitParam::SpeedDrift => (-0.01, 0.01),
+            // Relative to the period-derived estimate: the objective scales it (see `bounds`).
+            FitParam::Omega0 => (0.95, 1.05),
+            FitParam::Beta => (0.0, 0.2),
+            FitParam::Alpha => (0.0, 0.5),
+            FitParam::MBearing | FitParam::DryC => (0.0, 0.05),
         }
     }
 
@@ -122,7 +154,25 @@ impl FitParam {
             FitParam::EncoderOffset => e.encoder_offset_rad = Some(v),
             FitParam::AccelDelay => e.accel_delay_s = Some(v),
             FitParam::SpeedDrift => e.speed_drift_hz_per_s = Some(v),
+            // Identifiable ratios of a free decay: no SI counterpart without m, l and J.
+            FitParam::Omega0
+            | FitParam::Beta
+            | FitParam::Alpha
+            | FitParam::MBearing
+            | FitParam::DryC => {}
         }
+    }
+
+    /// Free-decay parameters (identifiable ratios, excitation off).
+    pub fn is_free_decay(self) -> bool {
+        matches!(
+            self,
+            FitParam::Omega0
+                | FitParam::Beta
+                | FitParam::Alpha
+                | FitParam::MBearing
+                | FitParam::DryC
+        )
     }
 }
 
@@ -162,6 +212,90 @@ impl ModelSpec {
             "reference" => Some(Self::reference()),
             "linear" => Some(Self::linear()),
             _ => None,
+        }
+    }
+
+    /// The same model for free decays, in identifiable terms: ω0 first, then each damping term
+    /// as its ratio per unit inertia (a → α, b → β, μ → M, T_c → c), and the swing's centre
+    /// (`encoder_offset`), which a decay of a few hundredths of a radian cannot do without.
+    /// Effects that need a shaker or an SI inertia are refused (the error says which).
+    pub fn free_decay(&self) -> Result<ModelSpec, String> {
+        if self.is_free_decay() {
+            return Ok(self.clone());
+        }
+        let mut params = vec![FitParam::Omega0];
+        for p in &self.params {
+            let q = match p {
+                FitParam::A => FitParam::Alpha,
+                FitParam::B => FitParam::Beta,
+                FitParam::Mu => FitParam::MBearing,
+                FitParam::CoulombConstant => FitParam::DryC,
+                FitParam::EncoderOffset => FitParam::EncoderOffset,
+                other => {
+                    return Err(format!(
+                    "{} cannot be fitted to a free decay (no shaker; inertia absorbed in omega0)",
+                    other.name()
+                ))
+                }
+            };
+            if !params.contains(&q) {
+                params.push(q);
+            }
+        }
+        if !params.contains(&FitParam::EncoderOffset) {
+            params.push(FitParam::EncoderOffset);
+        }
+        Ok(ModelSpec {
+            name: self.name.clone(),
+            params,
+            fixed: Effects::default(),
+        })
+    }
+
+    /// Whether this is a free-decay model (fits ω0 in identifiable terms).
+    pub fn is_free_decay(&self) -> bool {
+        self.params.contains(&FitParam::Omega0)
+    }
+
+    /// Value of a parameter in `x`, if the model fits it.
+    pub fn value_of(&self, p: FitParam, x: &[f64]) -> Option<f64> {
+        self.params
+            .iter()
+            .zip(x)
+            .find(|(q, _)| **q == p)
+            .map(|(_, v)| *v)
+    }
+
+    /// The dimensionless free-decay model for values `x` (excitation off).
+    pub fn free_model(&self, x: &[f64]) -> Model {
+        let mut d = pendulum_model::Dimensionless::conservative();
+        for (p, &v) in self.params.iter().zip(x) {
+            match p {
+                FitParam::Beta => d.beta = v,
+                FitParam::Alpha => d.alpha = v,
+                FitParam::MBearing => d.m_coulomb = v,
+                FitParam::DryC => d.c = v,
+                _ => {}
+            }
+        }
+        Model::with_excitation(d, pendulum_model::Excitation::None)
+    }
+
+    /// The model a run is simulated with: driven by its crank, or free (excitation off).
+    pub fn run_model(&self, run: &PreparedRun, x: &[f64]) -> Model {
+        if run.free {
+            self.free_model(x)
+        } else {
+            Model::new(self.physical(&run.rig, run.omega_hz, x).to_dimensionless())
+        }
+    }
+
+    /// Factor from a run's time unit to the model's: ω0/ω0_est for a free decay whose ω0 is
+    /// fitted, else exactly 1.
+    pub fn time_scale(&self, run: &PreparedRun, x: &[f64]) -> f64 {
+        match self.value_of(FitParam::Omega0, x) {
+            Some(w) if run.free => w / run.omega0_rad_s,
+            _ => 1.0,
         }
     }
 
@@ -211,17 +345,26 @@ pub struct PreparedRun {
     /// segment's first sample in `t`, θ rad, dθ/dt dimensionless). Empty = single shooting over
     /// the whole window (the study's method).
     pub restarts: Vec<(usize, [f64; 2])>,
+    /// A free decay (excitation off; `omega_hz` is NaN and `tail_t` are plain sample times).
+    pub free: bool,
+    /// The time unit of `t`, rad/s: sqrt(g/l) with a shaker, the period-derived ω0 estimate
+    /// for a free decay.
+    pub omega0_rad_s: f64,
 }
 
 impl PreparedRun {
     /// ω0 of the run, rad/s.
     pub fn omega0(&self) -> f64 {
-        self.rig.omega0_rad_s()
+        self.omega0_rad_s
     }
 
-    /// Dimensionless crank period.
+    /// Dimensionless crank period (a small swing's, 2π, for a free decay).
     pub fn period(&self) -> f64 {
-        self.omega0() / self.omega_hz
+        if self.free {
+            2.0 * std::f64::consts::PI
+        } else {
+            self.omega0() / self.omega_hz
+        }
     }
 }
 
@@ -236,7 +379,10 @@ enum Window {
 }
 
 /// Simulates `model` from `y0` through `run`'s window (θ measured = θ + `offset`); with
-/// restarts, each later segment starts again from its measured state.
+/// restarts, each later segment starts again from its measured state. `k` converts the run's
+/// time unit to the model's (1 except for a free decay with a fitted ω0): times × k, rates / k.
+/// The returned end state is in the model's units.
+#[allow(clippy::too_many_arguments)]
 fn window_error(
     model: &Model,
     opts: &SimOptions,
@@ -244,6 +390,7 @@ fn window_error(
     y0: [f64; 2],
     offset: f64,
     bound: f64,
+    k: f64,
 ) -> Window {
     let mut sum = 0.0;
     let mut end = y0;
@@ -252,27 +399,27 @@ fn window_error(
         return Window::Done(0.0, y0);
     }
     // Initial and restart states are in measured coordinates (θ_meas = θ + offset).
-    let mut starts: Vec<(usize, f64, [f64; 2])> = vec![(0, 0.0, [y0[0] - offset, y0[1]])];
+    let mut starts: Vec<(usize, f64, [f64; 2])> = vec![(0, 0.0, [y0[0] - offset, y0[1] / k])];
     for &(i, y) in &run.restarts {
         if i > 0 && i < n {
-            starts.push((i, run.t[i], [y[0] - offset, y[1]]));
+            starts.push((i, run.t[i] * k, [y[0] - offset, y[1] / k]));
         }
     }
     let mut seg_opts = *opts;
     for (s, &(i0, t_start, y_start)) in starts.iter().enumerate() {
         let i1 = starts.get(s + 1).map_or(n, |x| x.0);
-        let t_end = run.t[i1 - 1];
-        let mut k = i0;
+        let t_end = run.t[i1 - 1] * k;
+        let mut j = i0;
         let res = integrate(
             model,
             &seg_opts,
             t_start,
             y_start,
             t_end,
-            run.t[i0..i1].iter().copied(),
+            run.t[i0..i1].iter().map(|t| t * k),
             |smp| {
-                sum += (run.theta[k] - (smp.theta + offset)).abs();
-                k += 1;
+                sum += (run.theta[j] - (smp.theta + offset)).abs();
+                j += 1;
                 end = [smp.theta, smp.theta_dot];
                 if sum > bound {
                     ControlFlow::Break(())
@@ -295,14 +442,41 @@ fn window_error(
 }
 
 /// The simulated steady state over the run's tail, classified like the measurement
-/// (θ at each Poincaré time and a quarter period later).
+/// (θ at each Poincaré time and a quarter period later; a free decay's θ at its tail's sample
+/// times, rest or not). `t_from` and `y_from` are in the model's time unit, `k` as in
+/// `window_error`.
 pub fn simulated_steady(
     model: &Model,
     opts: &SimOptions,
     run: &PreparedRun,
     t_from: f64,
     y_from: [f64; 2],
+    k: f64,
 ) -> Option<SteadyState> {
+    if run.free {
+        let times: Vec<f64> = run
+            .tail_t
+            .iter()
+            .map(|t| t * k)
+            .filter(|&t| t >= t_from)
+            .collect();
+        let t_end = *times.last()?;
+        let mut th = Vec::with_capacity(times.len());
+        integrate(
+            model,
+            opts,
+            t_from,
+            y_from,
+            t_end,
+            times.iter().copied(),
+            |s| {
+                th.push(s.theta);
+                ControlFlow::Continue(())
+            },
+        )
+        .ok()?;
+        return Some(crate::measured::classify_free(&th, run.classify.rest_tol));
+    }
     let q = 0.25 * run.period();
     let mut times: Vec<f64> = Vec::with_capacity(run.tail_t.len() * 2);
     for &t in &run.tail_t {
@@ -404,11 +578,7 @@ impl StudyObjective<'_> {
 
     /// The model of run j for parameters p.
     pub fn model_of(&self, run: &PreparedRun, p: &[f64]) -> Model {
-        Model::new(
-            self.spec
-                .physical(&run.rig, run.omega_hz, p)
-                .to_dimensionless(),
-        )
+        self.spec.run_model(run, p)
     }
 
     fn offset(&self, p: &[f64]) -> f64 {
@@ -432,11 +602,12 @@ impl StudyObjective<'_> {
         let mut f = 0.0;
         for (j, run) in self.runs.iter().enumerate() {
             let model = self.model_of(run, &p);
+            let k = self.spec.time_scale(run, &p);
             let y0 = [ics[2 * j], ics[2 * j + 1]];
-            match window_error(&model, &self.sim, run, y0, off, f64::INFINITY) {
+            match window_error(&model, &self.sim, run, y0, off, f64::INFINITY, k) {
                 Window::Done(e, end) => {
-                    let t_last = *run.t.last().unwrap_or(&0.0);
-                    let st = simulated_steady(&model, &self.sim, run, t_last, end);
+                    let t_last = *run.t.last().unwrap_or(&0.0) * k;
+                    let st = simulated_steady(&model, &self.sim, run, t_last, end, k);
                     let differs = st.is_none_or(|s| s.class != run.steady.class);
                     f += if self.penalty && differs {
                         self.kappa * e
@@ -468,10 +639,28 @@ impl Problem for StudyObjective<'_> {
     }
 
     fn bounds(&self) -> Vec<(f64, f64)> {
+        // ω0's bounds are relative to the runs' period-derived estimate (one pendulum per
+        // campaign: their mean); a free decay's centre is within a few degrees of hanging.
+        let w_est = {
+            let w: Vec<f64> = self.runs.iter().map(|r| r.omega0_rad_s).collect();
+            w.iter().sum::<f64>() / w.len().max(1) as f64
+        };
+        let free = self.spec.is_free_decay();
         let mut b: Vec<(f64, f64)> = if self.fixed_params.is_some() {
             Vec::new()
         } else {
-            self.spec.params.iter().map(|p| p.bounds()).collect()
+            self.spec
+                .params
+                .iter()
+                .map(|p| match p {
+                    FitParam::Omega0 => {
+                        let (lo, hi) = p.bounds();
+                        (lo * w_est, hi * w_est)
+                    }
+                    FitParam::EncoderOffset if free => (-0.05, 0.05),
+                    _ => p.bounds(),
+                })
+                .collect()
         };
         for run in self.runs {
             for v in run.ic_est {
@@ -485,12 +674,17 @@ impl Problem for StudyObjective<'_> {
         let (p, ics) = self.split(x);
         let off = self.offset(&p);
         let models: Vec<Model> = self.runs.iter().map(|r| self.model_of(r, &p)).collect();
+        let ks: Vec<f64> = self
+            .runs
+            .iter()
+            .map(|r| self.spec.time_scale(r, &p))
+            .collect();
         let mut es = Vec::with_capacity(self.runs.len());
         let mut ends = Vec::with_capacity(self.runs.len());
         let mut total = 0.0;
         for (j, run) in self.runs.iter().enumerate() {
             let y0 = [ics[2 * j], ics[2 * j + 1]];
-            match window_error(&models[j], &self.sim, run, y0, off, bound - total) {
+            match window_error(&models[j], &self.sim, run, y0, off, bound - total, ks[j]) {
                 Window::Done(e, end) => {
                     total += e;
                     es.push(e);
@@ -514,8 +708,8 @@ impl Problem for StudyObjective<'_> {
                 if total > bound {
                     return Cost::AtLeast(total.max(bound.next_up()));
                 }
-                let t_last = *run.t.last().unwrap_or(&0.0);
-                let st = simulated_steady(&models[j], &self.sim, run, t_last, ends[j]);
+                let t_last = *run.t.last().unwrap_or(&0.0) * ks[j];
+                let st = simulated_steady(&models[j], &self.sim, run, t_last, ends[j], ks[j]);
                 if st.is_none_or(|s| s.class != run.steady.class) {
                     total += (self.kappa - 1.0) * es[j];
                 }

@@ -57,7 +57,12 @@ pub fn prepare_run(
     steady_cfg: &SteadyConfig,
     window: &Window,
 ) -> Result<PreparedRun, ProcessError> {
-    let w0 = run.rig.omega0_rad_s();
+    // A free decay's time unit is its period-derived ω0 (sqrt(g/l) is wrong for an arm).
+    let w0 = if al.is_free() {
+        al.omega0_est_rad_s
+    } else {
+        run.rig.omega0_rad_s()
+    };
     let (t, th) = (&run.enc_t_s, &run.theta_rad);
     let lo = t.partition_point(|&x| x < al.t0_s);
     let hi = t.partition_point(|&x| x <= al.t0_s + window.window_s);
@@ -73,7 +78,11 @@ pub fn prepare_run(
     let rate = (hi - lo - 1) as f64 / (t[hi - 1] - t[lo]).max(1e-9);
     let step = ((rate / window.sample_hz).round() as usize).max(1);
     let idx: Vec<usize> = (lo..hi).step_by(step).collect();
-    let period_s = 1.0 / al.omega_hz;
+    let period_s = if al.is_free() {
+        std::f64::consts::TAU / w0
+    } else {
+        1.0 / al.omega_hz
+    };
     let t_end = t[t.len() - 1];
     let mut tail_t = Vec::new();
     // The simulated steady state is classified over the same span as the measured one (the
@@ -83,19 +92,33 @@ pub fn prepare_run(
             al.t0_s + window.window_s + 0.5 * ts,
             al.t0_s + window.window_s + ts,
         ),
+        None if al.is_free() => (
+            crate::measured::free_tail_start_s(t_end, al.t0_s, steady_cfg),
+            t_end,
+        ),
         None => (t_end - steady_cfg.tail_s, t_end),
+    };
+    // A free decay has no Poincaré section: its tail is sampled 16 times per small swing.
+    let step_s = if al.is_free() {
+        period_s / 16.0
+    } else {
+        period_s
     };
     let mut x = from;
     while x <= to - 0.25 * period_s {
         tail_t.push(w0 * (x - al.t0_s));
-        x += period_s;
+        x += step_s;
     }
     let ts: Vec<f64> = idx.iter().map(|&i| w0 * (t[i] - al.t0_s)).collect();
     let mut restarts = Vec::new();
-    if let Some(seg) = window
-        .segment_s
-        .filter(|s| *s > 0.0 && *s < window.window_s)
-    {
+    // A free decay's segments span at least two small swings: damping acts over cycles, and
+    // segments shorter than a swing leave it to the restarts' estimated rates (biased fits).
+    let segment_s = if al.is_free() {
+        window.segment_s.map(|s| s.max(2.0 * period_s))
+    } else {
+        window.segment_s
+    };
+    if let Some(seg) = segment_s.filter(|s| *s > 0.0 && *s < window.window_s) {
         let ic_cfg = IcConfig::default();
         let mut k = 1;
         loop {
@@ -121,6 +144,8 @@ pub fn prepare_run(
         steady: *steady,
         tail_t,
         classify: steady_cfg.classify_options(w0 * period_s),
+        free: al.is_free(),
+        omega0_rad_s: w0,
     })
 }
 
@@ -292,7 +317,6 @@ pub fn identify(
     progress: Option<ProgressFn>,
 ) -> Result<FitOutcome, ProcessError> {
     cfg.validate()?;
-    let spec = cfg.spec()?;
     if runs.is_empty() {
         return Err(ProcessError::BadConfig {
             stage: "fit".into(),
@@ -300,6 +324,8 @@ pub fn identify(
             message: "no identify runs".into(),
         });
     }
+    let spec = spec_for_runs(cfg.spec()?, runs, "fit")?;
+    let free = spec.is_free_decay();
     let objective = StudyObjective {
         runs,
         spec: &spec,
@@ -331,7 +357,9 @@ pub fn identify(
         })));
     }
     let res = driver.run()?;
-    let polished = if cfg.polish {
+    // A free decay's objective is smooth and cheap: Nelder–Mead from DE's best always runs, and
+    // its point is the result when it is better (DE alone with a small budget stops short).
+    let polished = if cfg.polish || free {
         let step: Vec<f64> = objective
             .bounds_vec()
             .iter()
@@ -342,7 +370,11 @@ pub fn identify(
     } else {
         None
     };
-    let eval = objective.evaluate(&res.best_x);
+    let best_x = match &polished {
+        Some((x, f, _)) if free && *f < res.best_cost => x.clone(),
+        _ => res.best_x.clone(),
+    };
+    let eval = objective.evaluate(&best_x);
     let n = spec.params.len();
     let run_fits = runs
         .iter()
@@ -351,15 +383,15 @@ pub fn identify(
             id: r.id.clone(),
             role: r.role,
             ic_est: r.ic_est,
-            ic_fit: [res.best_x[n + 2 * j], res.best_x[n + 2 * j + 1]],
+            ic_fit: [best_x[n + 2 * j], best_x[n + 2 * j + 1]],
             e_theta: eval.per_run_e[j],
             measured: r.steady,
             simulated: eval.per_run_sim_steady[j],
         })
         .collect();
     Ok(FitOutcome {
-        params: res.best_x[..n].to_vec(),
-        f_obj: res.best_cost,
+        params: best_x[..n].to_vec(),
+        f_obj: if free { eval.f_obj } else { res.best_cost },
         e_theta: eval.e_theta,
         generations: res.generations,
         evaluations: res.evaluations,
@@ -377,6 +409,37 @@ pub fn identify(
         polished: polished.map(|(x, f, k)| (x[..n].to_vec(), f, k)),
         spec,
     })
+}
+
+/// The model to fit or validate on `runs`: a free-decay campaign gets the spec's identifiable
+/// counterpart ([`ModelSpec::free_decay`]); free decays and shaker runs cannot share one fit.
+pub fn spec_for_runs(
+    spec: ModelSpec,
+    runs: &[PreparedRun],
+    stage: &str,
+) -> Result<ModelSpec, ProcessError> {
+    let bad = |message: String| ProcessError::BadConfig {
+        stage: stage.into(),
+        field: "model".into(),
+        message,
+    };
+    let n_free = runs.iter().filter(|r| r.free).count();
+    if n_free == 0 {
+        if spec.is_free_decay() {
+            return Err(bad(format!(
+                "model {} is a free-decay model (omega0 and damping per unit inertia) but the runs have a shaker",
+                spec.name
+            )));
+        }
+        return Ok(spec);
+    }
+    if n_free < runs.len() {
+        return Err(bad(format!(
+            "{n_free} of {} runs are free decays (no shaker): fit free decays and shaker runs separately",
+            runs.len()
+        )));
+    }
+    spec.free_decay().map_err(bad)
 }
 
 impl StudyObjective<'_> {
@@ -419,6 +482,20 @@ pub fn validate(
     cfg: &ValidateConfig,
 ) -> Result<Vec<RunFit>, ProcessError> {
     use rayon::prelude::*;
+    if runs.is_empty() {
+        return Ok(Vec::new());
+    }
+    let checked = spec_for_runs(spec.clone(), runs, "validate")?;
+    if checked.params != spec.params {
+        return Err(ProcessError::BadConfig {
+            stage: "validate".into(),
+            field: "model".into(),
+            message: format!(
+                "model {} has the shaker's physical parameters but the runs are free decays: fit them with pendulum identify",
+                spec.name
+            ),
+        });
+    }
     runs.par_iter()
         .map(|run| {
             let single = std::slice::from_ref(run);
@@ -479,11 +556,20 @@ pub fn residual_series(
     window: &Window,
     t_end_s: f64,
 ) -> Result<ResidualSeries, ProcessError> {
-    let w0 = run.rig.omega0_rad_s();
-    let model = Model::new(
-        spec.physical(&run.rig, al.omega_hz, params)
-            .to_dimensionless(),
-    );
+    // Free decay: the fitted ω0 is the time unit; the fitted initial rate is in units of the
+    // period-derived estimate.
+    let (w0, model, rate_scale) = if al.is_free() {
+        let w = spec
+            .value_of(FitParam::Omega0, params)
+            .unwrap_or(al.omega0_est_rad_s);
+        (w, spec.free_model(params), al.omega0_est_rad_s / w)
+    } else {
+        let model = Model::new(
+            spec.physical(&run.rig, al.omega_hz, params)
+                .to_dimensionless(),
+        );
+        (run.rig.omega0_rad_s(), model, 1.0)
+    };
     let (t, th) = (&run.enc_t_s, &run.theta_rad);
     let lo = t.partition_point(|&x| x < al.t0_s);
     let hi = t.partition_point(|&x| x <= al.t0_s + t_end_s);
@@ -506,7 +592,7 @@ pub fn residual_series(
         &model,
         &SimOptions::with_tol(1e-9),
         0.0,
-        [ic_fit[0] - offset, ic_fit[1]],
+        [ic_fit[0] - offset, ic_fit[1] * rate_scale],
         t_last,
         times.iter().copied(),
         |s| {
@@ -535,9 +621,14 @@ pub fn steady_from(
     params: &[f64],
     y0: [f64; 2],
 ) -> Option<SteadyState> {
-    let model = Model::new(
-        spec.physical(&run.rig, run.omega_hz, params)
-            .to_dimensionless(),
-    );
-    simulated_steady(&model, &SimOptions::with_tol(1e-8), run, 0.0, y0)
+    let model = spec.run_model(run, params);
+    let k = spec.time_scale(run, params);
+    simulated_steady(
+        &model,
+        &SimOptions::with_tol(1e-8),
+        run,
+        0.0,
+        [y0[0], y0[1] / k],
+        k,
+    )
 }

@@ -3,6 +3,8 @@
 
 pub mod align;
 pub mod fit;
+#[cfg(test)]
+mod free_tests;
 pub mod ic;
 pub mod identify;
 pub mod linalg;
@@ -10,7 +12,7 @@ pub mod measured;
 pub mod pipeline;
 pub mod run;
 
-pub use align::{align, AlignConfig, Alignment};
+pub use align::{align, AlignConfig, Alignment, AlignmentKind};
 pub use run::{RigParams, Role, RunData};
 
 /// Errors of the processing stages; each names the run or stage and what was expected.

@@ -1,7 +1,7 @@
 //! The measured steady state of a run's tail, classified like a simulation (Poincaré section,
 //! one point per crank turn) with tolerances above the encoder's resolution and noise.
 
-use pendulum_model::{classify_history, ClassifyOptions, SteadyState};
+use pendulum_model::{classify_history, ClassifyOptions, SteadyClass, SteadyState};
 use serde::{Deserialize, Serialize};
 
 use crate::run::RunData;
@@ -63,4 +63,43 @@ pub fn measured_steady_state(
         run: run.id.clone(),
         reason: format!("steady state of the last {} s: {e}", cfg.tail_s),
     })
+}
+
+/// Class of a free decay's tail (no forcing period to take a Poincaré section with): `rest` when
+/// θ stays within `rest_tol_rad` of its mean over the tail, else `oscillation` (the capture ended
+/// while it still swung). The tail is the last `tail_s` but at most a quarter of the record from
+/// `t_from_s`: a decay is mostly transient, and `tail_s` is sized for forced runs.
+pub fn free_steady_state(
+    run: &RunData,
+    t_from_s: f64,
+    cfg: &SteadyConfig,
+) -> Result<SteadyState, ProcessError> {
+    let t_end = *run.enc_t_s.last().ok_or_else(|| ProcessError::Run {
+        run: run.id.clone(),
+        reason: "no encoder samples".into(),
+    })?;
+    let from = free_tail_start_s(t_end, t_from_s, cfg);
+    let lo = run.enc_t_s.partition_point(|&x| x < from);
+    Ok(classify_free(&run.theta_rad[lo..], cfg.rest_tol_rad))
+}
+
+/// `rest` when the angles stay within `rest_tol` of their mean, else `oscillation`.
+pub fn classify_free(theta: &[f64], rest_tol: f64) -> SteadyState {
+    let n = theta.len().max(1) as f64;
+    let mean = theta.iter().sum::<f64>() / n;
+    let still = theta.iter().all(|v| (v - mean).abs() <= rest_tol);
+    SteadyState {
+        class: if still {
+            SteadyClass::Rest
+        } else {
+            SteadyClass::Oscillation
+        },
+        period: u32::from(!still),
+        mean_theta_dot: 0.0,
+    }
+}
+
+/// Start of a free decay's classified tail, s (see [`free_steady_state`]).
+pub fn free_tail_start_s(t_end_s: f64, t_from_s: f64, cfg: &SteadyConfig) -> f64 {
+    (t_end_s - cfg.tail_s).max(t_end_s - 0.25 * (t_end_s - t_from_s))
 }

@@ -25,7 +25,7 @@ use crate::ic::{estimate_state, hanging_position, IcConfig, InitialState};
 use crate::identify::{
     identify, prepare_run, validate, FitConfig, FitOutcome, ProgressFn, RunFit, ValidateConfig,
 };
-use crate::measured::{measured_steady_state, SteadyConfig};
+use crate::measured::{free_steady_state, measured_steady_state, SteadyConfig};
 use crate::run::{Role, RunData};
 use crate::ProcessError;
 
@@ -254,7 +254,12 @@ impl Stage for SteadyStage {
         ctx.steady_cfg = self.0.clone();
         for run in &ctx.runs {
             let al = ctx.require(&ctx.alignments, &run.id, "the alignment", self.name())?;
-            let s = measured_steady_state(run, al.omega_hz, &self.0)?;
+            // A free decay has no forcing period: its tail is at rest or still swinging.
+            let s = if al.is_free() {
+                free_steady_state(run, al.t0_s, &self.0)?
+            } else {
+                measured_steady_state(run, al.omega_hz, &self.0)?
+            };
             ctx.steady.insert(run.id.clone(), s);
         }
         Ok(())

@@ -1,0 +1,127 @@
+//! A synthetic free decay (no shaker) through the stages: align, initial conditions, measured
+//! steady state, fit in identifiable terms; the fit must recover the simulated ω0 and damping.
+
+use std::ops::ControlFlow;
+
+use pendulum_model::{integrate, Dimensionless, Excitation, Model, SimOptions, SteadyClass};
+
+use crate::align::{align, AlignConfig};
+use crate::fit::FitParam;
+use crate::ic::{estimate_state, IcConfig};
+use crate::identify::{identify, prepare_run, FitConfig, Window};
+use crate::measured::{free_steady_state, SteadyConfig};
+use crate::run::{RigParams, Role, RunData};
+
+const OMEGA0: f64 = 7.0;
+const BETA: f64 = 0.01;
+const M_BEARING: f64 = 0.003;
+const OFFSET: f64 = 0.002;
+
+/// Released from 0.8 rad after a 0.3 s hold, 1 kHz, 40000-count encoder, centre off by
+/// `OFFSET`; m, l, r and Ω unknown (NaN / None), as a time-series campaign may leave them.
+fn synthetic_decay() -> RunData {
+    let d = Dimensionless {
+        beta: BETA,
+        m_coulomb: M_BEARING,
+        ..Dimensionless::conservative()
+    };
+    let model = Model::with_excitation(d, Excitation::None);
+    let (hold_s, dur_s, dt) = (0.3, 24.0, 1e-3);
+    let n = (dur_s / dt) as usize;
+    let times: Vec<f64> = (0..n).map(|i| i as f64 * dt).collect();
+    let free: Vec<f64> = times
+        .iter()
+        .filter(|&&t| t >= hold_s)
+        .map(|t| (t - hold_s) * OMEGA0)
+        .collect();
+    let mut th = Vec::new();
+    integrate(
+        &model,
+        &SimOptions::with_tol(1e-10),
+        0.0,
+        [0.8, 0.0],
+        *free.last().unwrap(),
+        free.iter().copied(),
+        |s| {
+            th.push(s.theta);
+            ControlFlow::Continue(())
+        },
+    )
+    .unwrap();
+    let q = std::f64::consts::TAU / 40000.0;
+    let theta: Vec<f64> = std::iter::repeat_n(0.8, n - th.len())
+        .chain(th)
+        .map(|v| ((v + OFFSET) / q).floor() * q + 0.5 * q)
+        .collect();
+    RunData {
+        id: "free".into(),
+        role: Role::Identify,
+        rig: RigParams {
+            m_kg: f64::NAN,
+            l_m: f64::NAN,
+            crank_r_m: f64::NAN,
+            rod_l_m: f64::NAN,
+            r_b_m: f64::NAN,
+            omega_hz: None,
+            g_m_s2: 9.81,
+        },
+        enc_t_s: times,
+        theta_rad: theta,
+        acc_t_s: Vec::new(),
+        az_m_s2: Vec::new(),
+        ax_m_s2: Vec::new(),
+    }
+}
+
+#[test]
+fn free_decay_fit_recovers_omega0_and_damping() {
+    let run = synthetic_decay();
+    let al = align(&run, &AlignConfig::default()).expect("free-decay alignment");
+    assert!(al.is_free() && al.omega_hz.is_nan());
+    // t = 0 at the first turning point: the release after the hold.
+    assert!((al.t0_s - 0.3).abs() < 0.01, "t0 = {}", al.t0_s);
+    assert!(
+        (al.omega0_est_rad_s - OMEGA0).abs() < 0.02 * OMEGA0,
+        "{}",
+        al.omega0_est_rad_s
+    );
+    let ic = estimate_state(&run, al.t0_s, &IcConfig::default()).expect("initial state");
+    let steady_cfg = SteadyConfig::default();
+    let steady = free_steady_state(&run, al.t0_s, &steady_cfg).expect("steady");
+    assert_eq!(
+        steady.class,
+        SteadyClass::Oscillation,
+        "still swinging at 24 s"
+    );
+    let window = Window {
+        window_s: 10.0,
+        sample_hz: 100.0,
+        // the pipeline's default; a free decay's segments are stretched to two swings
+        segment_s: Some(0.5),
+        t_sim_s: None,
+    };
+    let prepared = prepare_run(&run, &al, &ic, &steady, &steady_cfg, &window).expect("prepare");
+    let cfg = FitConfig {
+        model: "linear".into(),
+        effects: vec![FitParam::Mu],
+        window,
+        np: Some(30),
+        max_generations: 60,
+        threads: Some(1),
+        ..FitConfig::default()
+    };
+    let fit = identify(std::slice::from_ref(&prepared), &cfg, None).expect("fit");
+    let v = |p: FitParam| fit.spec.value_of(p, &fit.params).expect("fitted");
+    let (w, b, m, off) = (
+        v(FitParam::Omega0),
+        v(FitParam::Beta),
+        v(FitParam::MBearing),
+        v(FitParam::EncoderOffset),
+    );
+    eprintln!("omega0 {w} beta {b} M {m} offset {off} E {}", fit.e_theta);
+    assert!((w - OMEGA0).abs() < 0.002 * OMEGA0, "omega0 {w}");
+    assert!((b - BETA).abs() < 0.02 * BETA, "beta {b}");
+    assert!((m - M_BEARING).abs() < 0.02 * M_BEARING, "M {m}");
+    assert!((off - OFFSET).abs() < 2e-4, "offset {off}");
+    assert!(fit.runs[0].steady_agrees(), "{:?}", fit.runs[0]);
+}
