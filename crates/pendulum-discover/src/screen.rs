@@ -238,8 +238,7 @@ pub const ENCODER_OFFSET_FLOOR_RAD: f64 = 4.0 * 2.0 * std::f64::consts::PI / 409
 /// m g l θ_off cos θ, is not mistaken for a position torque) but never named.
 pub fn is_nuisance(s: &Screened) -> bool {
     s.candidate.effect == "encoder_offset"
-        && s
-            .fit
+        && s.fit
             .coef_of(15)
             .is_some_and(|(v, _)| v.abs() <= ENCODER_OFFSET_FLOOR_RAD)
 }

@@ -101,8 +101,8 @@ pub fn set_weights(rows: &mut [WeakRow], residuals: &[f64]) {
         for k in 0..classes {
             let g = &idx[k * n / classes..(k + 1) * n / classes];
             let m = g.iter().map(|&i| residuals[i]).sum::<f64>() / g.len() as f64;
-            let var = g.iter().map(|&i| (residuals[i] - m).powi(2)).sum::<f64>()
-                / (g.len() as f64 - 1.0);
+            let var =
+                g.iter().map(|&i| (residuals[i] - m).powi(2)).sum::<f64>() / (g.len() as f64 - 1.0);
             for &i in g {
                 rows[i].weight = 1.0 / var.max(1e-300);
             }

@@ -286,7 +286,8 @@ impl ModelSpec {
         if run.free {
             self.free_model(x)
         } else {
-            Model::new(self.physical(&run.rig, run.omega_hz, x).to_dimensionless())
+            // model_for: an accel_delay shifts the forcing's phase (Model::new alone would drop it).
+            model_for(&self.physical(&run.rig, run.omega_hz, x))
         }
     }
 

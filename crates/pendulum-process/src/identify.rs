@@ -5,7 +5,7 @@ use std::ops::ControlFlow;
 use std::sync::Arc;
 
 use pendulum_fit::{DeConfig, Driver, FnObserver, GenerationStats, StopRule};
-use pendulum_model::{integrate, Model, SimOptions, SteadyState};
+use pendulum_model::{integrate, SimOptions, SteadyState};
 use serde::{Deserialize, Serialize};
 
 use crate::align::Alignment;
@@ -564,10 +564,7 @@ pub fn residual_series(
             .unwrap_or(al.omega0_est_rad_s);
         (w, spec.free_model(params), al.omega0_est_rad_s / w)
     } else {
-        let model = Model::new(
-            spec.physical(&run.rig, al.omega_hz, params)
-                .to_dimensionless(),
-        );
+        let model = crate::fit::model_for(&spec.physical(&run.rig, al.omega_hz, params));
         (run.rig.omega0_rad_s(), model, 1.0)
     };
     let (t, th) = (&run.enc_t_s, &run.theta_rad);
