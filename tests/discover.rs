@@ -255,3 +255,18 @@ fn survey_issue_5_constant_dry_torque_hit_rate() {
     eprintln!("survey: named alone in {hits} of 6");
     assert!(hits >= 4, "named alone in only {hits} of 6");
 }
+
+#[test]
+fn regression_issue_5_finds_accel_gain() {
+    let mut r = rng(10);
+    let k = r.random_range(0.02..0.08) * if r.random::<bool>() { 1.0 } else { -1.0 };
+    let s = discover(
+        139,
+        Base::Reference,
+        0.0,
+        0.5,
+        0.15,
+        &format!("accel_gain_k_a = {k}"),
+    );
+    assert_found(&s, "accel_gain", k, 0.25, 0.0);
+}
