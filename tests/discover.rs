@@ -270,3 +270,18 @@ fn regression_issue_5_finds_accel_gain() {
     );
     assert_found(&s, "accel_gain", k, 0.25, 0.0);
 }
+
+#[test]
+fn regression_issue_5_finds_speed_drift() {
+    let mut r = rng(11);
+    let d = r.random_range(0.0005..0.002) * if r.random::<bool>() { 1.0 } else { -1.0 };
+    let s = discover(
+        149,
+        Base::Reference,
+        0.0,
+        0.5,
+        0.15,
+        &format!("speed_drift_hz_per_s = {d}"),
+    );
+    assert_found(&s, "speed_drift", d, 0.25, 0.0);
+}

@@ -19,6 +19,7 @@
 
 use pendulum_fit::{Cost, Problem};
 use pendulum_model::PositionTorque;
+use pendulum_process::align::fit_speed_drift;
 use pendulum_process::fit::{FitParam, ModelSpec, PreparedRun, StudyObjective};
 use pendulum_process::identify::{validate, FitOutcome, RunFit, ValidateConfig};
 use pendulum_process::pipeline::Context;
@@ -271,6 +272,156 @@ fn accel_gain_row(ctx: &Context, cfg: &DiscoverConfig) -> Option<DiagnosisRow> {
     })
 }
 
+/// What the accelerometer says about a drifting crank speed (see [`speed_drift_row`]).
+struct DriftEvidence {
+    fits: std::collections::BTreeMap<String, pendulum_process::align::DriftFit>,
+    /// Identify runs used.
+    n: usize,
+    /// Mean dΩ/dτ, Hz/s, and the half-width of its 95 % interval.
+    est: f64,
+    half: f64,
+    delta_bic: f64,
+    /// Interval excludes 0 and ΔBIC beats the screen threshold.
+    significant: bool,
+}
+
+/// Each shaker run's crank model refitted with a linearly drifting speed
+/// ([`fit_speed_drift`]); dΩ/dτ is the identify runs' mean (interval from their scatter,
+/// Student's t; ΔBIC over the runs' values against 0).
+fn drift_evidence(ctx: &Context, cfg: &DiscoverConfig) -> Option<DriftEvidence> {
+    let mut fits = std::collections::BTreeMap::new();
+    for run in &ctx.runs {
+        if let Some(f) = ctx
+            .alignments
+            .get(&run.id)
+            .and_then(|al| fit_speed_drift(run, al))
+        {
+            fits.insert(run.id.clone(), f);
+        }
+    }
+    let d_id: Vec<f64> = ctx
+        .runs
+        .iter()
+        .filter(|r| r.role == Role::Identify)
+        .filter_map(|r| fits.get(&r.id))
+        .map(|f| f.drift_hz_per_s)
+        .collect();
+    let n = d_id.len();
+    if n < 3 {
+        return None;
+    }
+    let nf = n as f64;
+    let est = d_id.iter().sum::<f64>() / nf;
+    let rss1 = d_id.iter().map(|d| (d - est).powi(2)).sum::<f64>();
+    let rss0 = d_id.iter().map(|d| d * d).sum::<f64>();
+    let half = t95(n - 1) * (rss1 / (nf - 1.0) / nf).sqrt();
+    let delta_bic = nf * (rss1.max(1e-300) / rss0.max(1e-300)).ln() + nf.ln();
+    let excludes_zero = est - half > 0.0 || est + half < 0.0;
+    Some(DriftEvidence {
+        fits,
+        n,
+        est,
+        half,
+        delta_bic,
+        significant: excludes_zero && delta_bic < cfg.screen_threshold,
+    })
+}
+
+/// The runs re-aligned on their drifting crank phase (t0, Ω at t0, dΩ/dτ), initial states
+/// re-estimated at the new t0.
+fn realigned(ctx: &Context, ev: &DriftEvidence) -> Result<Context, ProcessError> {
+    let mut ctx2 = Context::new(ctx.runs.clone());
+    ctx2.steady = ctx.steady.clone();
+    ctx2.steady_cfg = ctx.steady_cfg.clone();
+    ctx2.hanging = ctx.hanging.clone();
+    for run in &ctx.runs {
+        let (Some(al), Some(ic)) = (ctx.alignments.get(&run.id), ctx.initial.get(&run.id)) else {
+            continue;
+        };
+        let mut al2 = al.clone();
+        let mut ic2 = ic.clone();
+        if let Some(f) = ev.fits.get(&run.id) {
+            al2.t0_s = f.t0_s;
+            al2.omega_hz = f.omega_hz;
+            al2.speed_drift_hz_per_s = f.drift_hz_per_s;
+            ic2 = pendulum_process::ic::estimate_state(run, f.t0_s, &Default::default())?;
+        }
+        ctx2.alignments.insert(run.id.clone(), al2);
+        ctx2.initial.insert(run.id.clone(), ic2);
+    }
+    Ok(ctx2)
+}
+
+/// `speed_drift` shows in the accelerometer before it shows in the pendulum ([`drift_evidence`]).
+/// When that evidence is significant, the extended model (the runs re-aligned on the drifting
+/// phase, dΩ/dτ a fitted parameter) is refitted on the identify runs and validated like any
+/// candidate against the base refitted the same way; it is accepted when the validate runs'
+/// E_θ falls by more than the candidates' noise rule. (The extended model of the outputs does
+/// not carry it: its residual series use the constant-speed alignment.)
+#[allow(clippy::too_many_arguments)]
+fn speed_drift_row(
+    ev: &DriftEvidence,
+    ctx2: Option<&Context>,
+    cfg: &DiscoverConfig,
+    base_fit: &FitOutcome,
+    id_runs: &[PreparedRun],
+    val_runs: &[PreparedRun],
+    ics: &[f64],
+    gain_needed: f64,
+) -> Result<DiagnosisRow, ProcessError> {
+    let (n, est, half) = (ev.n, ev.est, ev.half);
+    let mut row = DiagnosisRow {
+        effect: "speed_drift".into(),
+        accepted: false,
+        estimate: est,
+        ci_low: est - half,
+        ci_high: est + half,
+        unit: "Hz/s".into(),
+        delta_bic: ev.delta_bic,
+        heldout_gain: f64::NAN,
+        screen_estimate: est,
+        e_validate_before: f64::NAN,
+        e_validate_after: f64::NAN,
+        note: format!("crank fits with a drifting speed on {n} identify runs; screened out"),
+    };
+    let Some(ctx2) = ctx2.filter(|_| ev.significant && !base_fit.spec.params.is_empty()) else {
+        return Ok(row);
+    };
+    let id2 = ctx2.prepared(Role::Identify, &cfg.validate.window, "discover")?;
+    let val2 = ctx2.prepared(Role::Validate, &cfg.validate.window, "discover")?;
+    let ics2: Vec<f64> = id2
+        .iter()
+        .flat_map(|r| [r.ic_est[0], r.ic_est[1]])
+        .collect();
+    let mut spec = base_fit.spec.clone();
+    spec.params.push(FitParam::SpeedDrift);
+    spec.name = format!("{}+speed_drift", spec.name);
+    let mut x0 = base_fit.params.clone();
+    x0.push(est);
+    let (x, f) = refit(&id2, &spec, &x0, &ics2, cfg.refit_evals);
+    let val = validate(&val2, &spec, &x, &cfg.validate)?;
+    let (xb, _) = refit(
+        id_runs,
+        &base_fit.spec,
+        &base_fit.params,
+        ics,
+        cfg.refit_evals,
+    );
+    let val_b = validate(val_runs, &base_fit.spec, &xb, &cfg.validate)?;
+    let (before, after) = (e_total(&val_b), e_total(&val));
+    let gain = 1.0 - after / before.max(1e-12);
+    row.accepted = gain > gain_needed;
+    row.heldout_gain = gain;
+    row.e_validate_before = before;
+    row.e_validate_after = after;
+    row.note = format!(
+        "crank fits with a drifting speed on {n} identify runs; trajectory refit dΩ/dτ {:.4e} Hz/s (f_obj {f:.4}) on the re-aligned runs; E_θ gain needed > {:.3}",
+        x.last().copied().unwrap_or(f64::NAN),
+        gain_needed
+    );
+    Ok(row)
+}
+
 /// The extended model spec and the initial values of its new parameters.
 fn extend(
     spec: &ModelSpec,
@@ -455,11 +606,21 @@ pub fn discover(
         w0: first.rig.omega0_rad_s(),
     };
 
+    // A drifting crank speed, read from the accelerometer first: when it is significant the
+    // equation-error view uses the re-aligned forcing, so that its growing phase error is not
+    // mistaken for another effect (an accelerometer lag, say).
+    let drift = drift_evidence(ctx, cfg);
+    let ctx_drift = match &drift {
+        Some(ev) if ev.significant => Some(realigned(ctx, ev)?),
+        _ => None,
+    };
+    let weak_ctx = ctx_drift.as_ref().unwrap_or(ctx);
+
     // The equation-error view of every run.
     let mut weak = Vec::new();
     let mut weak_runs = Vec::new();
     for (i, run) in ctx.runs.iter().enumerate() {
-        if let Some(al) = ctx.alignments.get(&run.id) {
+        if let Some(al) = weak_ctx.alignments.get(&run.id) {
             for mut r in weak_rows(i, run, al, &cfg.weak) {
                 r.run = weak_runs.len();
                 weak.push(r);
@@ -766,6 +927,23 @@ pub fn discover(
     }
     if let Some(row) = accel_gain_row(ctx, cfg) {
         // Before `unexplained`, which stays last.
+        let at = rows
+            .iter()
+            .position(|r| r.effect == "unexplained")
+            .unwrap_or(rows.len());
+        rows.insert(at, row);
+    }
+    if let Some(ev) = &drift {
+        let row = speed_drift_row(
+            ev,
+            ctx_drift.as_ref(),
+            cfg,
+            &base_fit,
+            &id_runs,
+            &val_runs,
+            &ics,
+            gain_needed,
+        )?;
         let at = rows
             .iter()
             .position(|r| r.effect == "unexplained")

@@ -192,19 +192,23 @@ pub fn weak_rows(run_idx: usize, run: &RunData, al: &Alignment, cfg: &WeakConfig
     let w0 = run.rig.omega0_rad_s();
     let lambda = run.rig.crank_r_m / run.rig.rod_l_m;
     let omega = 2.0 * std::f64::consts::PI * al.omega_hz / w0;
+    // dω/dt, dimensionless (zero unless the run was re-aligned on a drifting speed).
+    let omega_dot = 2.0 * std::f64::consts::PI * al.speed_drift_hz_per_s / (w0 * w0);
     let r_over_l = run.rig.crank_r_m / run.rig.l_m;
-    // Forcing in the aligned dimensionless time (φ = ωt), and its rate.
+    // Forcing in the aligned dimensionless time (φ = ωt + ½ω̇t²), and its rate.
+    let ay_at = |tt: f64| -> (f64, f64) {
+        let phi = omega * tt + 0.5 * omega_dot * tt * tt;
+        let rate = omega + omega_dot * tt;
+        (
+            r_over_l * (rate * rate * crank_f2(phi, lambda) + omega_dot * crank_f1(phi, lambda)),
+            phi,
+        )
+    };
     let forcing = |tau: f64| -> (f64, f64, f64) {
         let tt = tau * w0;
-        let phi = omega * tt;
-        let ay = r_over_l * omega * omega * crank_f2(phi, lambda);
+        let (ay, phi) = ay_at(tt);
         let h = 1e-4;
-        let d = r_over_l
-            * omega
-            * omega
-            * (crank_f2(phi + omega * h, lambda) - crank_f2(phi - omega * h, lambda))
-            / (2.0 * h);
-        let _ = crank_f1;
+        let d = (ay_at(tt + h).0 - ay_at(tt - h).0) / (2.0 * h);
         (ay, d, phi.rem_euclid(2.0 * std::f64::consts::PI))
     };
     let mut rows = Vec::new();
@@ -406,6 +410,7 @@ mod tests {
             az_offset_m_s2: 9.81,
             residual_rms_m_s2: 0.0,
             fit_window_s: (0.0, 0.0),
+            speed_drift_hz_per_s: 0.0,
         };
         let rows = weak_rows(0, &run, &al, &WeakConfig::default());
         assert!(rows.len() > 50, "{} rows", rows.len());

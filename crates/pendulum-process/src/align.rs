@@ -16,7 +16,7 @@
 //! frequency estimated from the swing periods (`pendulum_explain::omega_n_estimate`), since
 //! sqrt(g/l) is wrong for a physical pendulum and m, l may be unknown.
 
-use pendulum_model::excitation::crank_f2;
+use pendulum_model::excitation::{crank_f1, crank_f2};
 use serde::{Deserialize, Serialize};
 
 use crate::linalg::{inverse, solve};
@@ -131,6 +131,10 @@ pub struct Alignment {
     pub residual_rms_m_s2: f64,
     /// The window the crank model was fitted on, s.
     pub fit_window_s: (f64, f64),
+    /// dΩ/dτ from t0, Hz/s: 0 from [`align`]; set when a run is re-aligned on a drifting speed
+    /// ([`fit_speed_drift`]).
+    #[serde(default)]
+    pub speed_drift_hz_per_s: f64,
 }
 
 fn nan() -> f64 {
@@ -178,6 +182,7 @@ pub fn align_free_decay(run: &RunData) -> Result<Alignment, ProcessError> {
         az_offset_m_s2: f64::NAN,
         residual_rms_m_s2: f64::NAN,
         fit_window_s: (f64::NAN, f64::NAN),
+        speed_drift_hz_per_s: 0.0,
     })
 }
 
@@ -405,5 +410,105 @@ pub fn align(run: &RunData, cfg: &AlignConfig) -> Result<Alignment, ProcessError
         az_offset_m_s2: c0,
         residual_rms_m_s2: rms,
         fit_window_s: (w_start, w_end),
+        speed_drift_hz_per_s: 0.0,
+    })
+}
+
+/// A crank fit that lets the speed drift linearly (the effect `speed_drift`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct DriftFit {
+    /// The positive acceleration peak nearest the alignment's t0 under the drifting phase, s.
+    pub t0_s: f64,
+    /// Crank speed at that peak, Hz.
+    pub omega_hz: f64,
+    /// dΩ/dτ, Hz/s, and its standard uncertainty.
+    pub drift_hz_per_s: f64,
+    pub drift_sigma_hz_per_s: f64,
+    /// RMS of the fit's residual, m/s².
+    pub residual_rms_m_s2: f64,
+}
+
+/// Refits a shaker run's crank model from the alignment's window start to the end of the
+/// capture with a linearly drifting speed Ω(τ) = Ω0 + (dΩ/dτ)·τ, τ from the (re-found) t0:
+/// a_z = c0 + G·r·[(2πΩ(τ))² f''(φ) + 2π(dΩ/dτ) f'(φ)], φ = 2π(Ω0 τ + ½(dΩ/dτ)τ²).
+/// Gauss–Newton from the constant-speed alignment (numerical Jacobian). `None` for free decays
+/// or when the fit does not converge.
+pub fn fit_speed_drift(run: &RunData, al: &Alignment) -> Option<DriftFit> {
+    debug_assert!(
+        al.speed_drift_hz_per_s == 0.0,
+        "re-fitting a re-aligned run"
+    );
+    if al.is_free() {
+        return None;
+    }
+    let (t, az) = (&run.acc_t_s, &run.az_m_s2);
+    let r = run.rig.crank_r_m;
+    let lambda = r / run.rig.rod_l_m;
+    let two_pi = 2.0 * std::f64::consts::PI;
+    let idx: Vec<usize> = (0..t.len())
+        .filter(|&i| t[i] >= al.fit_window_s.0)
+        .collect();
+    if idx.len() < 50 {
+        return None;
+    }
+    // p = [c0, G, Ω0 (Hz), dΩ/dτ (Hz/s), δ (s): the peak's shift from al.t0_s].
+    let model = |p: &[f64; 5], ti: f64| -> f64 {
+        let tau = ti - al.t0_s - p[4];
+        let phi = two_pi * (p[2] * tau + 0.5 * p[3] * tau * tau);
+        let rate = two_pi * (p[2] + p[3] * tau);
+        p[0] + p[1]
+            * r
+            * (rate * rate * crank_f2(phi, lambda) + two_pi * p[3] * crank_f1(phi, lambda))
+    };
+    let mut p = [al.az_offset_m_s2, al.accel_gain, al.omega_hz, 0.0, 0.0];
+    let steps = [1e-4, 1e-7, 1e-8, 1e-8, 1e-7];
+    let mut cov = [0.0; 25];
+    let mut rms = f64::NAN;
+    let mut converged = false;
+    for _ in 0..20 {
+        let mut jtj = [0.0; 25];
+        let mut jtr = [0.0; 5];
+        let mut ss = 0.0;
+        for &i in &idx {
+            let v = model(&p, t[i]);
+            let res = az[i] - v;
+            ss += res * res;
+            let mut j = [0.0; 5];
+            for (k, jk) in j.iter_mut().enumerate() {
+                let (mut hi, mut lo) = (p, p);
+                hi[k] += steps[k];
+                lo[k] -= steps[k];
+                *jk = (model(&hi, t[i]) - model(&lo, t[i])) / (2.0 * steps[k]);
+            }
+            for a in 0..5 {
+                jtr[a] += j[a] * res;
+                for b in 0..5 {
+                    jtj[a * 5 + b] += j[a] * j[b];
+                }
+            }
+        }
+        let n = idx.len() as f64;
+        rms = (ss / n).sqrt();
+        let delta = solve(&jtj, &jtr, 5)?;
+        let s2 = ss / (n - 5.0);
+        if let Some(inv) = inverse(&jtj, 5) {
+            for (c, v) in cov.iter_mut().zip(inv) {
+                *c = v * s2;
+            }
+        }
+        for a in 0..5 {
+            p[a] += delta[a];
+        }
+        if delta[2].abs() < 1e-12 * p[2] && delta[3].abs() < 1e-12 && delta[4].abs() < 1e-10 {
+            converged = true;
+            break;
+        }
+    }
+    (converged && p[1] > 0.0 && p[2] > 0.0).then_some(DriftFit {
+        t0_s: al.t0_s + p[4],
+        omega_hz: p[2],
+        drift_hz_per_s: p[3],
+        drift_sigma_hz_per_s: cov[3 * 5 + 3].max(0.0).sqrt(),
+        residual_rms_m_s2: rms,
     })
 }
