@@ -339,7 +339,7 @@ fn realigned(ctx: &Context, ev: &DriftEvidence) -> Result<Context, ProcessError>
             continue;
         };
         let mut al2 = al.clone();
-        let mut ic2 = ic.clone();
+        let mut ic2 = *ic;
         if let Some(f) = ev.fits.get(&run.id) {
             al2.t0_s = f.t0_s;
             al2.omega_hz = f.omega_hz;
