@@ -310,3 +310,12 @@ fn survey_issue_5_false_alarm_rate() {
     eprintln!("survey: false alarms in {alarms} of 8");
     assert!(alarms <= 1, "false alarms in {alarms} of 8");
 }
+
+/// `viscous_linear` is a reference-model term: it is found where the model in hand lacks it,
+/// here dry bearing friction alone (`--base dry`) on data with viscous drag.
+#[test]
+fn regression_issue_5_dry_base_finds_viscous_drag() {
+    let b = rng(12).random_range(0.3..0.7);
+    let s = discover(151, Base::Dry, 0.0, b, 0.15, "");
+    assert_found(&s, "viscous_linear", b, 0.25, 0.0);
+}

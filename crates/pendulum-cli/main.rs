@@ -146,6 +146,8 @@ struct DiscoverArgs {
 enum BaseArg {
     Reference,
     Linear,
+    /// Dry bearing friction alone (μ): the base in which viscous drag can be missing.
+    Dry,
 }
 
 #[derive(clap::Args)]
@@ -285,6 +287,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 base: match a.base {
                     BaseArg::Reference => pendulum_discover::Base::Reference,
                     BaseArg::Linear => pendulum_discover::Base::Linear,
+                    BaseArg::Dry => pendulum_discover::Base::Dry,
                 },
                 pipeline: a.pipeline,
                 generations: a.generations,

@@ -131,6 +131,11 @@ impl Scales {
 fn to_si(c: &Candidate, fit: &crate::screen::Ols, s: &Scales) -> (f64, f64, &'static str) {
     let first = |col: usize| fit.coef_of(col).unwrap_or((f64::NAN, f64::NAN));
     match c.effect.as_str() {
+        "viscous_linear" => {
+            // β = b/(m ω0).
+            let (v, e) = first(0);
+            (v * s.m * s.w0, e * s.m * s.w0, "N·s/m")
+        }
         "viscous_quadratic" => {
             let (v, e) = first(1);
             (v * s.m / s.l, e * s.m / s.l, "kg/m")
@@ -433,6 +438,7 @@ fn extend(
     let (est, _, _) = to_si(c, fit, s);
     let mut news = Vec::new();
     match c.effect.as_str() {
+        "viscous_linear" => news.push((FitParam::B, est.max(0.0))),
         "viscous_quadratic" => news.push((FitParam::A, est.max(0.0))),
         "coulomb_bearing" => news.push((FitParam::Mu, est.max(0.0))),
         "bearing_load_base_accel" => out.fixed.bearing_load_base_accel = true,

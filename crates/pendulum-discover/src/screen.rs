@@ -19,6 +19,8 @@ pub enum Base {
     Reference,
     /// b only (the classic model).
     Linear,
+    /// μ only (dry bearing friction alone).
+    Dry,
 }
 
 impl Base {
@@ -26,6 +28,7 @@ impl Base {
         match self {
             Base::Reference => "reference",
             Base::Linear => "linear",
+            Base::Dry => "dry",
         }
     }
 
@@ -34,6 +37,7 @@ impl Base {
         match self {
             Base::Reference => vec![0, 1, 2],
             Base::Linear => vec![0],
+            Base::Dry => vec![2],
         }
     }
 }
@@ -63,6 +67,10 @@ pub fn candidates(base: Base) -> Vec<Candidate> {
     if base == Base::Linear {
         out.push(cand("viscous_quadratic", vec![1]));
         out.push(cand("coulomb_bearing", vec![2]));
+    }
+    if base == Base::Dry {
+        out.push(cand("viscous_linear", vec![0]));
+        out.push(cand("viscous_quadratic", vec![1]));
     }
     if base == Base::Reference {
         out.push(Candidate {

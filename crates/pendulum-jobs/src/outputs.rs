@@ -280,6 +280,8 @@ pub fn read_params(path: &Path, model: Option<&str>) -> Result<FitOutcome, JobEr
             };
             let base = if name.starts_with("linear") {
                 ModelSpec::linear()
+            } else if name.starts_with("dry") {
+                ModelSpec::dry()
             } else {
                 ModelSpec::reference()
             };

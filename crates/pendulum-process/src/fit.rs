@@ -206,11 +206,21 @@ impl ModelSpec {
         }
     }
 
-    /// By name: `reference` or `linear`.
+    /// Dry bearing friction alone: μ only (the base in which `viscous_linear` can be missing).
+    pub fn dry() -> Self {
+        Self {
+            name: "dry".into(),
+            params: vec![FitParam::Mu],
+            fixed: Effects::default(),
+        }
+    }
+
+    /// By name: `reference`, `linear` or `dry`.
     pub fn by_name(name: &str) -> Option<Self> {
         match name {
             "reference" => Some(Self::reference()),
             "linear" => Some(Self::linear()),
+            "dry" => Some(Self::dry()),
             _ => None,
         }
     }

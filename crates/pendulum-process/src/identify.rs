@@ -210,7 +210,7 @@ impl FitConfig {
             stage: "fit".into(),
             field: "model".into(),
             message: format!(
-                "unknown model {:?}: expected reference or linear",
+                "unknown model {:?}: expected reference, linear or dry",
                 self.model
             ),
         })?;
