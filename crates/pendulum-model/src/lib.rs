@@ -10,7 +10,7 @@ pub mod steady;
 #[cfg(test)]
 mod physics_tests;
 
-pub use excitation::{CrankDrive, Excitation, MeasuredAccel};
+pub use excitation::{CrankDrive, CrankTable, Excitation, MeasuredAccel};
 pub use params::{Dimensionless, Effects, Physical, PositionTorque, EFFECT_NAMES};
 pub use sim::{integrate, simulate, Model, Sample, SimOptions, SimStats, Trajectory};
 pub use spec::ParamSpec;
