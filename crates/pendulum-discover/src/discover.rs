@@ -260,6 +260,7 @@ fn refit(
             ic_halfwidth: 0.1,
             fixed_params: None,
             penalty: true,
+            order: Default::default(),
         },
         ics: ics.to_vec(),
     };
@@ -535,6 +536,7 @@ pub fn discover(
                 ic_halfwidth: 0.1,
                 fixed_params: None,
                 penalty: true,
+                order: Default::default(),
             };
             let mut full = x.clone();
             full.extend_from_slice(&ics);

@@ -647,8 +647,20 @@ fn find_breakaway(model: &Model, t: f64, theta: f64, t_end: f64) -> Option<f64> 
         Excitation::None => return None,
     };
     h = h.min(0.1);
+    // A periodic forcing that has not broken the pendulum loose over one whole period never will
+    // (θ is fixed): scanning one period (and a step) is enough, however far t_end is.
+    let scan_end = match &model.excitation {
+        Excitation::Crank(c)
+            if c.omega_drift == 0.0
+                && c.omega > 0.0
+                && (c.t_start.is_none() || t >= c.t_at_speed()) =>
+        {
+            t_end.min(t + 2.0 * std::f64::consts::PI / c.omega + h)
+        }
+        _ => t_end,
+    };
     let mut a = t;
-    while a < t_end {
+    while a < scan_end {
         let b = (a + h).min(t_end);
         if excess(b) > 0.0 {
             // Bisect: excess(a) ≤ 0 < excess(b).
