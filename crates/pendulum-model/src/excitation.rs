@@ -46,9 +46,10 @@ const TABLE_N: usize = 256;
 #[derive(Debug)]
 pub struct CrankTable {
     lambda: f64,
-    /// Monomial coefficients in v ∈ [−1, 1] over each interval, of f'' and of f'.
-    f2: Vec<[f64; 6]>,
-    f1: Vec<[f64; 6]>,
+    /// Monomial coefficients in v ∈ [−1, 1] over each interval, of f'' and of f'. Interval i is
+    /// centred on φ = i·h, h = 2π/TABLE_N.
+    f2: Box<[[f64; 6]; TABLE_N]>,
+    f1: Box<[[f64; 6]; TABLE_N]>,
 }
 
 /// Tables depend on λ alone, so equal λ means equal tables.
@@ -68,10 +69,7 @@ impl CrankTable {
             let nodes: Vec<f64> = (0..n)
                 .map(|k| (std::f64::consts::PI * (k as f64 + 0.5) / n as f64).cos())
                 .collect();
-            let vals: Vec<f64> = nodes
-                .iter()
-                .map(|v| g(h * (i as f64 + 0.5 * (v + 1.0))))
-                .collect();
+            let vals: Vec<f64> = nodes.iter().map(|v| g(h * (i as f64 + 0.5 * v))).collect();
             let mut c = [0.0; 6];
             for (j, cj) in c.iter_mut().enumerate() {
                 let s: f64 = (0..n)
@@ -92,15 +90,13 @@ impl CrankTable {
                 16.0 * c[5],
             ]
         };
-        Self {
-            lambda,
-            f2: (0..TABLE_N)
-                .map(|i| fit(&|phi| crank_f2(phi, lambda), i))
-                .collect(),
-            f1: (0..TABLE_N)
-                .map(|i| fit(&|phi| crank_f1(phi, lambda), i))
-                .collect(),
+        let mut f2 = Box::new([[0.0; 6]; TABLE_N]);
+        let mut f1 = Box::new([[0.0; 6]; TABLE_N]);
+        for i in 0..TABLE_N {
+            f2[i] = fit(&|phi| crank_f2(phi, lambda), i);
+            f1[i] = fit(&|phi| crank_f1(phi, lambda), i);
         }
+        Self { lambda, f2, f1 }
     }
 
     /// The table of λ, shared: built once per λ a process uses (a handful: one per rig).
@@ -127,27 +123,28 @@ impl CrankTable {
         self.lambda
     }
 
-    #[inline]
-    fn eval(coef: &[[f64; 6]], phi: f64) -> f64 {
+    #[inline(always)]
+    fn eval(coef: &[[f64; 6]; TABLE_N], phi: f64) -> f64 {
+        // Round to the nearest interval centre without a float-to-int conversion: adding 1.5·2⁵²
+        // leaves the integer in the low bits (two's complement, so negative φ works too).
+        const SHIFT: f64 = 6_755_399_441_055_744.0;
         let x = phi * (TABLE_N as f64 / (2.0 * std::f64::consts::PI));
-        // floor(x) without a libm call (baseline x86-64 has no rounding instruction).
-        let k = x as i64 - i64::from(x < 0.0 && x != (x as i64) as f64);
-        // TABLE_N is a power of two: the mask is φ's interval mod one turn, negative φ included.
-        let c = &coef[(k & (TABLE_N as i64 - 1)) as usize];
-        let v = 2.0 * (x - k as f64) - 1.0;
+        let y = x + SHIFT;
+        let c = &coef[(y.to_bits() & (TABLE_N as u64 - 1)) as usize];
+        let v = 2.0 * (x - (y - SHIFT));
         // Estrin's scheme: a shorter dependency chain than Horner's.
         let v2 = v * v;
         (c[0] + v * c[1]) + v2 * ((c[2] + v * c[3]) + v2 * (c[4] + v * c[5]))
     }
 
     /// f''(φ), as [`crank_f2`].
-    #[inline]
+    #[inline(always)]
     pub fn f2(&self, phi: f64) -> f64 {
         Self::eval(&self.f2, phi)
     }
 
     /// f'(φ), as [`crank_f1`].
-    #[inline]
+    #[inline(always)]
     pub fn f1(&self, phi: f64) -> f64 {
         Self::eval(&self.f1, phi)
     }
@@ -241,7 +238,7 @@ impl CrankDrive {
     }
 
     /// As [`accel`](Self::accel), with f' and f'' from `table` (which must be of this λ).
-    #[inline]
+    #[inline(always)]
     pub fn accel_tabulated(&self, table: &CrankTable, t: f64) -> (f64, f64) {
         let (phi, dphi, ddphi) = self.phase(t);
         let mut ay = self.r_over_l * table.f2(phi) * dphi * dphi;
