@@ -148,8 +148,7 @@ pub fn sin_cos(x: f64) -> (f64, f64) {
                 + z * (-1.388_888_888_887_411e-3
                     + z * (2.480_158_728_947_673e-5
                         + z * (-2.755_731_435_139_066_3e-7
-                            + z * (2.087_572_321_298_175e-9
-                                + z * -1.135_964_755_778_819_5e-11)))));
+                            + z * (2.087_572_321_298_175e-9 + z * -1.135_964_755_778_819_5e-11)))));
     match (k as i64) & 3 {
         0 => (s, c),
         1 => (c, -s),
@@ -562,39 +561,44 @@ where
         }
         stats.steps += 1;
         err_old_beta = pow_ctrl(err.max(1e-4), beta);
-        let ydiff = [y_new[0] - y[0], y_new[1] - y[1]];
-        let bspl = [h * k1[0] - ydiff[0], h * k1[1] - ydiff[1]];
-        let dense = Dense {
-            t,
-            h,
-            r: [
-                y,
-                ydiff,
-                bspl,
-                [
-                    ydiff[0] - h * k7[0] - bspl[0],
-                    ydiff[1] - h * k7[1] - bspl[1],
+        // The dense output is built only for a step that holds an event or an output time (most
+        // steps of a steady-state tail hold neither).
+        let dense = || {
+            let ydiff = [y_new[0] - y[0], y_new[1] - y[1]];
+            let bspl = [h * k1[0] - ydiff[0], h * k1[1] - ydiff[1]];
+            Dense {
+                t,
+                h,
+                r: [
+                    y,
+                    ydiff,
+                    bspl,
+                    [
+                        ydiff[0] - h * k7[0] - bspl[0],
+                        ydiff[1] - h * k7[1] - bspl[1],
+                    ],
+                    [
+                        h * (dp::D1 * k1[0]
+                            + dp::D3 * k3[0]
+                            + dp::D4 * k4[0]
+                            + dp::D5 * k5[0]
+                            + dp::D6 * k6[0]
+                            + dp::D7 * k7[0]),
+                        h * (dp::D1 * k1[1]
+                            + dp::D3 * k3[1]
+                            + dp::D4 * k4[1]
+                            + dp::D5 * k5[1]
+                            + dp::D6 * k6[1]
+                            + dp::D7 * k7[1]),
+                    ],
                 ],
-                [
-                    h * (dp::D1 * k1[0]
-                        + dp::D3 * k3[0]
-                        + dp::D4 * k4[0]
-                        + dp::D5 * k5[0]
-                        + dp::D6 * k6[0]
-                        + dp::D7 * k7[0]),
-                    h * (dp::D1 * k1[1]
-                        + dp::D3 * k3[1]
-                        + dp::D4 * k4[1]
-                        + dp::D5 * k5[1]
-                        + dp::D6 * k6[1]
-                        + dp::D7 * k7[1]),
-                ],
-            ],
+            }
         };
         let t_new = if last { t_end } else { t + h };
         // Did θ̇ reach zero against the slip direction?
         let crossing = dir != 0.0 && y_new[1] * dir <= 0.0;
         if crossing {
+            let dense = dense();
             let te = locate_zero(&dense, t, t_new, dir);
             stats.events += 1;
             let mut ye = dense.eval(te);
@@ -630,12 +634,15 @@ where
             h = h_next.min(h);
             continue;
         }
-        while let Some(&ts) = times.peek() {
-            if ts <= t_new {
-                times.next();
-                emit!(ts, dense.eval(ts));
-            } else {
-                break;
+        if times.peek().is_some_and(|&ts| ts <= t_new) {
+            let dense = dense();
+            while let Some(&ts) = times.peek() {
+                if ts <= t_new {
+                    times.next();
+                    emit!(ts, dense.eval(ts));
+                } else {
+                    break;
+                }
             }
         }
         t = t_new;
