@@ -505,6 +505,7 @@ fn refit(
             ic_halfwidth: 0.1,
             fixed_params: None,
             penalty: true,
+            order: Default::default(),
         },
         ics: ics.to_vec(),
     };
@@ -815,6 +816,7 @@ pub fn discover(
                 ic_halfwidth: 0.1,
                 fixed_params: None,
                 penalty: true,
+                order: Default::default(),
             };
             let mut full = x.clone();
             full.extend_from_slice(&ics);

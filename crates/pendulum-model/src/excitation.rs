@@ -1,6 +1,8 @@
 //! Base excitation: the exact crank-rod motion of `rig.md` (the study's Eq. 2) or a measured
 //! acceleration signal. Everything here is dimensionless: time t = ω0·τ, accelerations divided by g.
 
+use std::sync::{Arc, Mutex};
+
 use serde::{Deserialize, Serialize};
 
 use crate::ModelError;
@@ -30,6 +32,122 @@ pub fn crank_f2(phi: f64, lambda: f64) -> f64 {
     let s2 = 2.0 * s * c;
     let c2 = c * c - s * s;
     c + lambda * (c2 / q + lambda * lambda * s2 * s2 / (4.0 * q2 * q))
+}
+
+/// Intervals per crank turn of a [`CrankTable`].
+const TABLE_N: usize = 256;
+
+/// f'(φ) and f''(φ) of one crank ratio λ, tabulated over a turn as piecewise quintics.
+///
+/// Why: the exact f'' costs a sin/cos, a square root and two divisions, and was a third of a
+/// fit's time (the right-hand side is evaluated ~10⁹ times). Each of the 256 intervals holds the
+/// quintic interpolating f at its six Chebyshev points: the error is below 1e-13 for λ ≤ 0.5,
+/// far under any integrator tolerance (see the test).
+#[derive(Debug)]
+pub struct CrankTable {
+    lambda: f64,
+    /// Monomial coefficients in v ∈ [−1, 1] over each interval, of f'' and of f'. Interval i is
+    /// centred on φ = i·h, h = 2π/TABLE_N.
+    f2: Box<[[f64; 6]; TABLE_N]>,
+    f1: Box<[[f64; 6]; TABLE_N]>,
+}
+
+/// Tables depend on λ alone, so equal λ means equal tables.
+impl PartialEq for CrankTable {
+    fn eq(&self, other: &Self) -> bool {
+        self.lambda.to_bits() == other.lambda.to_bits()
+    }
+}
+
+impl CrankTable {
+    /// Builds the table of crank ratio λ (|λ| < 1).
+    pub fn new(lambda: f64) -> Self {
+        let h = 2.0 * std::f64::consts::PI / TABLE_N as f64;
+        let fit = |g: &dyn Fn(f64) -> f64, i: usize| -> [f64; 6] {
+            // Chebyshev coefficients from the values at the 6 Chebyshev points, then monomials.
+            let n = 6;
+            let nodes: Vec<f64> = (0..n)
+                .map(|k| (std::f64::consts::PI * (k as f64 + 0.5) / n as f64).cos())
+                .collect();
+            let vals: Vec<f64> = nodes.iter().map(|v| g(h * (i as f64 + 0.5 * v))).collect();
+            let mut c = [0.0; 6];
+            for (j, cj) in c.iter_mut().enumerate() {
+                let s: f64 = (0..n)
+                    .map(|k| {
+                        vals[k]
+                            * (std::f64::consts::PI * j as f64 * (k as f64 + 0.5) / n as f64).cos()
+                    })
+                    .sum();
+                *cj = s * if j == 0 { 1.0 } else { 2.0 } / n as f64;
+            }
+            // T0 = 1, T1 = v, T2 = 2v² − 1, T3 = 4v³ − 3v, T4 = 8v⁴ − 8v² + 1, T5 = 16v⁵ − 20v³ + 5v.
+            [
+                c[0] - c[2] + c[4],
+                c[1] - 3.0 * c[3] + 5.0 * c[5],
+                2.0 * c[2] - 8.0 * c[4],
+                4.0 * c[3] - 20.0 * c[5],
+                8.0 * c[4],
+                16.0 * c[5],
+            ]
+        };
+        let mut f2 = Box::new([[0.0; 6]; TABLE_N]);
+        let mut f1 = Box::new([[0.0; 6]; TABLE_N]);
+        for i in 0..TABLE_N {
+            f2[i] = fit(&|phi| crank_f2(phi, lambda), i);
+            f1[i] = fit(&|phi| crank_f1(phi, lambda), i);
+        }
+        Self { lambda, f2, f1 }
+    }
+
+    /// The table of λ, shared: built once per λ a process uses (a handful: one per rig).
+    pub fn shared(lambda: f64) -> Arc<Self> {
+        static CACHE: Mutex<Vec<Arc<CrankTable>>> = Mutex::new(Vec::new());
+        let mut cache = CACHE.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(t) = cache
+            .iter()
+            .find(|t| t.lambda.to_bits() == lambda.to_bits())
+        {
+            return t.clone();
+        }
+        let t = Arc::new(Self::new(lambda));
+        // Bounded, in case a caller sweeps λ: the oldest table is dropped.
+        if cache.len() >= 16 {
+            cache.remove(0);
+        }
+        cache.push(t.clone());
+        t
+    }
+
+    /// The crank ratio λ tabulated.
+    pub fn lambda(&self) -> f64 {
+        self.lambda
+    }
+
+    #[inline(always)]
+    fn eval(coef: &[[f64; 6]; TABLE_N], phi: f64) -> f64 {
+        // Round to the nearest interval centre without a float-to-int conversion: adding 1.5·2⁵²
+        // leaves the integer in the low bits (two's complement, so negative φ works too).
+        const SHIFT: f64 = 6_755_399_441_055_744.0;
+        let x = phi * (TABLE_N as f64 / (2.0 * std::f64::consts::PI));
+        let y = x + SHIFT;
+        let c = &coef[(y.to_bits() & (TABLE_N as u64 - 1)) as usize];
+        let v = 2.0 * (x - (y - SHIFT));
+        // Estrin's scheme: a shorter dependency chain than Horner's.
+        let v2 = v * v;
+        (c[0] + v * c[1]) + v2 * ((c[2] + v * c[3]) + v2 * (c[4] + v * c[5]))
+    }
+
+    /// f''(φ), as [`crank_f2`].
+    #[inline(always)]
+    pub fn f2(&self, phi: f64) -> f64 {
+        Self::eval(&self.f2, phi)
+    }
+
+    /// f'(φ), as [`crank_f1`].
+    #[inline(always)]
+    pub fn f1(&self, phi: f64) -> f64 {
+        Self::eval(&self.f1, phi)
+    }
 }
 
 /// Crank angle as a function of time: at rest at `phi0` until `t_start`, a smooth spin-up to
@@ -115,6 +233,17 @@ impl CrankDrive {
         let mut ay = self.r_over_l * crank_f2(phi, self.lambda) * dphi * dphi;
         if ddphi != 0.0 {
             ay += self.r_over_l * crank_f1(phi, self.lambda) * ddphi;
+        }
+        (ay, ay * self.tan_delta)
+    }
+
+    /// As [`accel`](Self::accel), with f' and f'' from `table` (which must be of this λ).
+    #[inline(always)]
+    pub fn accel_tabulated(&self, table: &CrankTable, t: f64) -> (f64, f64) {
+        let (phi, dphi, ddphi) = self.phase(t);
+        let mut ay = self.r_over_l * table.f2(phi) * dphi * dphi;
+        if ddphi != 0.0 {
+            ay += self.r_over_l * table.f1(phi) * ddphi;
         }
         (ay, ay * self.tan_delta)
     }
@@ -272,6 +401,26 @@ mod tests {
                 assert!((d2 - crank_f2(phi, lambda)).abs() < 1e-5, "f'' at {phi}");
             }
         }
+    }
+
+    /// The tables agree with the exact f', f'' to 1e-13 (relative to their scale), any φ sign.
+    #[test]
+    fn crank_table_matches_exact() {
+        for &lambda in &[0.0, 0.126, 0.36, 0.5] {
+            let tab = CrankTable::new(lambda);
+            let mut worst: f64 = 0.0;
+            for i in 0..20_000 {
+                let phi = -300.0 + i as f64 * 0.0301;
+                worst = worst
+                    .max((tab.f2(phi) - crank_f2(phi, lambda)).abs())
+                    .max((tab.f1(phi) - crank_f1(phi, lambda)).abs());
+            }
+            assert!(worst < 1e-13 * (1.0 + lambda), "λ = {lambda}: {worst:e}");
+        }
+        assert!(Arc::ptr_eq(
+            &CrankTable::shared(0.126),
+            &CrankTable::shared(0.126)
+        ));
     }
 
     #[test]

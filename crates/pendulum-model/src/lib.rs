@@ -10,11 +10,13 @@ pub mod steady;
 #[cfg(test)]
 mod physics_tests;
 
-pub use excitation::{CrankDrive, Excitation, MeasuredAccel};
+pub use excitation::{CrankDrive, CrankTable, Excitation, MeasuredAccel};
 pub use params::{Dimensionless, Effects, Physical, PositionTorque, EFFECT_NAMES};
 pub use sim::{integrate, simulate, Model, Sample, SimOptions, SimStats, Trajectory};
 pub use spec::ParamSpec;
-pub use steady::{classify_history, classify_poincare, ClassifyOptions, SteadyClass, SteadyState};
+pub use steady::{
+    classify_history, classify_poincare, ClassifyOptions, PartialClass, SteadyClass, SteadyState,
+};
 
 /// Errors of the model crate.
 #[derive(Debug, thiserror::Error)]

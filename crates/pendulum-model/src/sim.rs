@@ -11,9 +11,11 @@
 //! |Q| ≤ C → stick (θ̇ = 0 exactly, θ fixed) until |Q(t)| > C(t); otherwise slip in direction sgn Q.
 
 use std::ops::ControlFlow;
+use std::sync::Arc;
 
 use serde::{Deserialize, Serialize};
 
+use crate::excitation::CrankTable;
 use crate::{Dimensionless, Excitation, ModelError};
 
 /// A model ready to integrate: parameters plus what drives the base.
@@ -21,6 +23,10 @@ use crate::{Dimensionless, Excitation, ModelError};
 pub struct Model {
     pub params: Dimensionless,
     pub excitation: Excitation,
+    /// Tabulated crank geometry (see [`Model::with_crank_table`]); used only while it matches
+    /// the crank's λ.
+    #[serde(skip)]
+    pub crank_table: Option<Arc<CrankTable>>,
 }
 
 impl Model {
@@ -29,12 +35,37 @@ impl Model {
         Self {
             excitation: Excitation::from_dimensionless(&params),
             params,
+            crank_table: None,
         }
     }
 
     /// Same parameters, another excitation.
     pub fn with_excitation(params: Dimensionless, excitation: Excitation) -> Self {
-        Self { params, excitation }
+        Self {
+            params,
+            excitation,
+            crank_table: None,
+        }
+    }
+
+    /// Evaluates a crank excitation from the shared [`CrankTable`] of its λ instead of the exact
+    /// formula (errors below 1e-13, a third cheaper right-hand side); no effect otherwise.
+    pub fn with_crank_table(mut self) -> Self {
+        if let Excitation::Crank(c) = &self.excitation {
+            self.crank_table = Some(CrankTable::shared(c.lambda));
+        }
+        self
+    }
+
+    /// Base accelerations (ÿ/g, ẍ/g) at time t.
+    #[inline(always)]
+    fn base_accel(&self, t: f64) -> (f64, f64) {
+        match (&self.excitation, &self.crank_table) {
+            (Excitation::Crank(c), Some(tab)) if tab.lambda() == c.lambda => {
+                c.accel_tabulated(tab, t)
+            }
+            (e, _) => e.accel(t),
+        }
     }
 
     fn has_dry_friction(&self) -> bool {
@@ -45,8 +76,8 @@ impl Model {
     #[inline]
     pub fn static_balance(&self, t: f64, theta: f64) -> (f64, f64) {
         let p = &self.params;
-        let (ay, ax) = self.excitation.accel(t);
-        let (s, c) = theta.sin_cos();
+        let (ay, ax) = self.base_accel(t);
+        let (s, c) = sin_cos(theta);
         let mut q = -(1.0 + ay) * s - ax * c;
         if p.p != 0.0 {
             q -= p.p * (p.k as f64 * theta + p.phi_p).sin();
@@ -63,8 +94,8 @@ impl Model {
     #[inline]
     pub fn accel(&self, t: f64, theta: f64, theta_dot: f64, dir: f64) -> f64 {
         let p = &self.params;
-        let (ay, ax) = self.excitation.accel(t);
-        let (s, c) = theta.sin_cos();
+        let (ay, ax) = self.base_accel(t);
+        let (s, c) = sin_cos(theta);
         let w2 = theta_dot * theta_dot;
         let mut q =
             -(1.0 + ay) * s - ax * c - p.beta * theta_dot - p.alpha * theta_dot * theta_dot.abs();
@@ -90,6 +121,74 @@ impl Model {
     pub fn energy(&self, theta: f64, theta_dot: f64) -> f64 {
         0.5 * (1.0 + self.params.j) * theta_dot * theta_dot - theta.cos()
     }
+}
+
+/// sin θ and cos θ within ~2 ulp for |θ| < 1e6 (fdlibm's kernels after a two-part reduction by
+/// π/2), inlined: libm's `sincos` was a quarter of a fit's time.
+#[inline]
+pub fn sin_cos(x: f64) -> (f64, f64) {
+    const PIO2_1: f64 = 1.570_796_326_734_125_6; // the first 33 bits of π/2
+    const PIO2_1T: f64 = 6.077_100_506_506_192e-11; // π/2 − PIO2_1
+                                                    // Round to nearest without a libm call (valid for |x·2/π| < 2^51).
+    const SHIFT: f64 = 6_755_399_441_055_744.0;
+    let k = (x * std::f64::consts::FRAC_2_PI + SHIFT) - SHIFT;
+    // k·PIO2_1 is exact for |k| < 2^20, so r carries x's own accuracy.
+    let r = (x - k * PIO2_1) - k * PIO2_1T;
+    let z = r * r;
+    let s = r + r
+        * z
+        * (-1.666_666_666_666_663_2e-1
+            + z * (8.333_333_333_322_49e-3
+                + z * (-1.984_126_982_985_795e-4
+                    + z * (2.755_731_370_707_006_8e-6
+                        + z * (-2.505_076_025_340_686_3e-8 + z * 1.589_690_995_211_55e-10)))));
+    let c = 1.0 - 0.5 * z
+        + z * z
+            * (4.166_666_666_666_66e-2
+                + z * (-1.388_888_888_887_411e-3
+                    + z * (2.480_158_728_947_673e-5
+                        + z * (-2.755_731_435_139_066_3e-7
+                            + z * (2.087_572_321_298_175e-9 + z * -1.135_964_755_778_819_5e-11)))));
+    match (k as i64) & 3 {
+        0 => (s, c),
+        1 => (c, -s),
+        2 => (-s, -c),
+        _ => (-c, s),
+    }
+}
+
+/// x^a for the step-size controller, x > 0 (0 below 1e-300), to ~1e-7 relative without a libm
+/// call: the controller needs no more (it multiplies by a safety factor of 0.9 anyway), and two
+/// `powf` per step were a tenth of a fit's time.
+#[inline]
+fn pow_ctrl(x: f64, a: f64) -> f64 {
+    if !(x > 1e-300) {
+        return 0.0;
+    }
+    const SHIFT: f64 = 6_755_399_441_055_744.0;
+    let ln2 = std::f64::consts::LN_2;
+    let bits = x.to_bits();
+    let e = (bits >> 52) as f64 - 1023.0;
+    let m = f64::from_bits((bits & ((1u64 << 52) - 1)) | (1023u64 << 52));
+    // ln m = 2 atanh t, t = (m − 1)/(m + 1) ∈ [0, 1/3).
+    let t = (m - 1.0) / (m + 1.0);
+    let t2 = t * t;
+    let ln_m = 2.0
+        * t
+        * (1.0
+            + t2 * (1.0 / 3.0
+                + t2 * (1.0 / 5.0 + t2 * (1.0 / 7.0 + t2 * (1.0 / 9.0 + t2 / 11.0)))));
+    let y = a * (e * ln2 + ln_m);
+    // e^y = 2^n e^r, |r| ≤ ln 2 / 2.
+    let n = (y * std::f64::consts::LOG2_E + SHIFT) - SHIFT;
+    let r = y - n * ln2;
+    let p = 1.0
+        + r * (1.0
+            + r / 2.0
+                * (1.0
+                    + r / 3.0
+                        * (1.0 + r / 4.0 * (1.0 + r / 5.0 * (1.0 + r / 6.0 * (1.0 + r / 7.0))))));
+    p * f64::from_bits(((n as i64 + 1023) as u64) << 52)
 }
 
 /// Relative margin by which the applied torque must exceed the static capacity to break loose.
@@ -318,7 +417,10 @@ where
         .filter(|h| *h > 0.0)
         .unwrap_or(1e-2)
         .min(opts.h_max);
-    let mut err_old: f64 = 1e-4;
+    // PI step-size control (Hairer's DOPRI5 constants); err_old^β is kept, not recomputed per
+    // attempt.
+    let beta = 0.04;
+    let mut err_old_beta: f64 = pow_ctrl(1e-4, beta);
     let mut k1: Y = [0.0; 2];
     let mut need_k1 = true;
 
@@ -446,10 +548,8 @@ where
             }
             continue;
         }
-        // PI step-size control (Hairer's DOPRI5 constants).
-        let beta = 0.04;
-        let fac11 = err.powf(0.2 - 0.75 * beta);
-        let fac = (fac11 / err_old.powf(beta) / 0.9).clamp(0.1, 5.0);
+        let fac11 = pow_ctrl(err, 0.2 - 0.75 * beta);
+        let fac = (fac11 / err_old_beta / 0.9).clamp(0.1, 5.0);
         let h_next = (h / fac).min(opts.h_max);
         if err > 1.0 {
             stats.rejected += 1;
@@ -460,40 +560,45 @@ where
             continue;
         }
         stats.steps += 1;
-        err_old = err.max(1e-4);
-        let ydiff = [y_new[0] - y[0], y_new[1] - y[1]];
-        let bspl = [h * k1[0] - ydiff[0], h * k1[1] - ydiff[1]];
-        let dense = Dense {
-            t,
-            h,
-            r: [
-                y,
-                ydiff,
-                bspl,
-                [
-                    ydiff[0] - h * k7[0] - bspl[0],
-                    ydiff[1] - h * k7[1] - bspl[1],
+        err_old_beta = pow_ctrl(err.max(1e-4), beta);
+        // The dense output is built only for a step that holds an event or an output time (most
+        // steps of a steady-state tail hold neither).
+        let dense = || {
+            let ydiff = [y_new[0] - y[0], y_new[1] - y[1]];
+            let bspl = [h * k1[0] - ydiff[0], h * k1[1] - ydiff[1]];
+            Dense {
+                t,
+                h,
+                r: [
+                    y,
+                    ydiff,
+                    bspl,
+                    [
+                        ydiff[0] - h * k7[0] - bspl[0],
+                        ydiff[1] - h * k7[1] - bspl[1],
+                    ],
+                    [
+                        h * (dp::D1 * k1[0]
+                            + dp::D3 * k3[0]
+                            + dp::D4 * k4[0]
+                            + dp::D5 * k5[0]
+                            + dp::D6 * k6[0]
+                            + dp::D7 * k7[0]),
+                        h * (dp::D1 * k1[1]
+                            + dp::D3 * k3[1]
+                            + dp::D4 * k4[1]
+                            + dp::D5 * k5[1]
+                            + dp::D6 * k6[1]
+                            + dp::D7 * k7[1]),
+                    ],
                 ],
-                [
-                    h * (dp::D1 * k1[0]
-                        + dp::D3 * k3[0]
-                        + dp::D4 * k4[0]
-                        + dp::D5 * k5[0]
-                        + dp::D6 * k6[0]
-                        + dp::D7 * k7[0]),
-                    h * (dp::D1 * k1[1]
-                        + dp::D3 * k3[1]
-                        + dp::D4 * k4[1]
-                        + dp::D5 * k5[1]
-                        + dp::D6 * k6[1]
-                        + dp::D7 * k7[1]),
-                ],
-            ],
+            }
         };
         let t_new = if last { t_end } else { t + h };
         // Did θ̇ reach zero against the slip direction?
         let crossing = dir != 0.0 && y_new[1] * dir <= 0.0;
         if crossing {
+            let dense = dense();
             let te = locate_zero(&dense, t, t_new, dir);
             stats.events += 1;
             let mut ye = dense.eval(te);
@@ -529,12 +634,15 @@ where
             h = h_next.min(h);
             continue;
         }
-        while let Some(&ts) = times.peek() {
-            if ts <= t_new {
-                times.next();
-                emit!(ts, dense.eval(ts));
-            } else {
-                break;
+        if times.peek().is_some_and(|&ts| ts <= t_new) {
+            let dense = dense();
+            while let Some(&ts) = times.peek() {
+                if ts <= t_new {
+                    times.next();
+                    emit!(ts, dense.eval(ts));
+                } else {
+                    break;
+                }
             }
         }
         t = t_new;
@@ -615,8 +723,20 @@ fn find_breakaway(model: &Model, t: f64, theta: f64, t_end: f64) -> Option<f64> 
         Excitation::None => return None,
     };
     h = h.min(0.1);
+    // A periodic forcing that has not broken the pendulum loose over one whole period never will
+    // (θ is fixed): scanning one period (and a step) is enough, however far t_end is.
+    let scan_end = match &model.excitation {
+        Excitation::Crank(c)
+            if c.omega_drift == 0.0
+                && c.omega > 0.0
+                && (c.t_start.is_none() || t >= c.t_at_speed()) =>
+        {
+            t_end.min(t + 2.0 * std::f64::consts::PI / c.omega + h)
+        }
+        _ => t_end,
+    };
     let mut a = t;
-    while a < t_end {
+    while a < scan_end {
         let b = (a + h).min(t_end);
         if excess(b) > 0.0 {
             // Bisect: excess(a) ≤ 0 < excess(b).
@@ -715,4 +835,36 @@ pub fn rk4_fixed(model: &Model, y0: [f64; 2], t0: f64, t_end: f64, h: f64) -> [f
         t += h;
     }
     y
+}
+
+#[cfg(test)]
+mod tests {
+    /// The inlined sin/cos agree with libm's to a few ulp of 1 over the angles a fit meets
+    /// (rotations run to thousands of radians).
+    #[test]
+    fn sin_cos_matches_libm() {
+        let mut worst: f64 = 0.0;
+        for i in 0..400_000 {
+            let x = -5000.0 + i as f64 * 0.025_000_1;
+            let (s, c) = super::sin_cos(x);
+            let (s0, c0) = x.sin_cos();
+            worst = worst.max((s - s0).abs()).max((c - c0).abs());
+        }
+        assert!(worst < 5e-16, "{worst:e}");
+        for i in 0..10_000 {
+            let x = 10f64.powf(-12.0 + i as f64 * 0.0021);
+            for a in [0.04, 0.17] {
+                let p = super::pow_ctrl(x, a);
+                assert!((p / x.powf(a) - 1.0).abs() < 1e-6, "{x}^{a}");
+            }
+        }
+        assert_eq!(super::pow_ctrl(0.0, 0.17), 0.0);
+        for x in [0.0, 1e-300, -0.0, std::f64::consts::FRAC_PI_4, 1.0e5] {
+            let (s, c) = super::sin_cos(x);
+            assert!(
+                (s - x.sin()).abs() < 5e-16 && (c - x.cos()).abs() < 5e-16,
+                "{x}"
+            );
+        }
+    }
 }

@@ -153,14 +153,7 @@ pub fn classify_poincare(theta: &[f64], theta_dot: &[f64], opts: &ClassifyOption
         });
         if repeats {
             // Net turns over one period of the orbit.
-            let turns = ((theta[p] - theta[0]) / (2.0 * std::f64::consts::PI)).round();
-            let class = if turns > 0.0 {
-                SteadyClass::RotationCcw
-            } else if turns < 0.0 {
-                SteadyClass::RotationCw
-            } else {
-                SteadyClass::Oscillation
-            };
+            let class = turns_class(theta[p] - theta[0]);
             return SteadyState {
                 class,
                 period: p as u32,
@@ -176,6 +169,102 @@ pub fn classify_poincare(theta: &[f64], theta_dot: &[f64], opts: &ClassifyOption
         class: SteadyClass::Chaos,
         period: 0,
         mean_theta_dot,
+    }
+}
+
+/// What the first Poincaré points already decide about [`classify_poincare`] on all `n` of them,
+/// so that a simulation can stop as soon as the class it will reach is certain (the decision is
+/// the classifier's own comparisons on the points seen, not a numerical guess).
+#[derive(Debug, Clone)]
+pub struct PartialClass {
+    n: usize,
+    opts: ClassifyOptions,
+    theta: Vec<f64>,
+    theta_dot: Vec<f64>,
+    theta_min: f64,
+    theta_max: f64,
+    /// Some |θ̇| is above the rest tolerance.
+    moving: bool,
+    /// `violated[p]`: two points p apart already differ, so the orbit is not of period p.
+    violated: Vec<bool>,
+}
+
+impl PartialClass {
+    /// For `n` points to come, classified with `opts`.
+    pub fn new(n: usize, opts: &ClassifyOptions) -> Self {
+        let max_p = (opts.max_period as usize).min(n / 2);
+        Self {
+            n,
+            opts: *opts,
+            theta: Vec::with_capacity(n),
+            theta_dot: Vec::with_capacity(n),
+            theta_min: f64::INFINITY,
+            theta_max: f64::NEG_INFINITY,
+            moving: false,
+            violated: vec![false; max_p + 1],
+        }
+    }
+
+    /// The next point (θ unwrapped, θ̇).
+    pub fn push(&mut self, theta: f64, theta_dot: f64) {
+        let m = self.theta.len();
+        for p in 1..self.violated.len().min(m + 1) {
+            if !self.violated[p] {
+                let (t0, w0) = (self.theta[m - p], self.theta_dot[m - p]);
+                // The negation of classify_poincare's repeat test, NaN included.
+                self.violated[p] = !(wrap_pi(theta - t0).abs() <= self.opts.theta_tol
+                    && (theta_dot - w0).abs() <= self.opts.theta_dot_tol);
+            }
+        }
+        self.theta_min = self.theta_min.min(theta);
+        self.theta_max = self.theta_max.max(theta);
+        self.moving |= !(theta_dot.abs() <= self.opts.theta_dot_tol);
+        self.theta.push(theta);
+        self.theta_dot.push(theta_dot);
+    }
+
+    /// The points so far (θ, θ̇).
+    pub fn points(&self) -> (&[f64], &[f64]) {
+        (&self.theta, &self.theta_dot)
+    }
+
+    /// `Some(true)` if the class of all `n` points is certain to differ from `class`,
+    /// `Some(false)` if it is certain to be `class`, `None` while undecided.
+    pub fn differs_from(&self, class: SteadyClass) -> Option<bool> {
+        if self.n < 2 {
+            return None;
+        }
+        let m = self.theta.len();
+        // Some θ is farther than rest_tol from any mean (a margin for the mean's rounding).
+        let not_rest = self.moving
+            || self.theta_max - self.theta_min > 2.0 * self.opts.rest_tol * (1.0 + 1e-6);
+        let periods = 1..self.violated.len();
+        match class {
+            SteadyClass::Rest => not_rest.then_some(true),
+            SteadyClass::Chaos => {
+                (not_rest && periods.clone().all(|p| self.violated[p])).then_some(false)
+            }
+            _ => {
+                // Rest or chaos would differ too: only a period whose turns give `class` matches.
+                let can_match = periods.clone().any(|p| {
+                    !self.violated[p]
+                        && (m <= p || turns_class(self.theta[p] - self.theta[0]) == class)
+                });
+                (!can_match).then_some(true)
+            }
+        }
+    }
+}
+
+/// The class of a repeating orbit that turns by `dtheta` over its period.
+fn turns_class(dtheta: f64) -> SteadyClass {
+    let turns = (dtheta / (2.0 * std::f64::consts::PI)).round();
+    if turns > 0.0 {
+        SteadyClass::RotationCcw
+    } else if turns < 0.0 {
+        SteadyClass::RotationCw
+    } else {
+        SteadyClass::Oscillation
     }
 }
 
@@ -269,6 +358,69 @@ mod tests {
             assert_eq!(c.as_str().parse::<SteadyClass>().unwrap(), c);
         }
         assert!("spinning".parse::<SteadyClass>().is_err());
+    }
+
+    /// Whenever a prefix decides, the full classification agrees with it.
+    #[test]
+    fn partial_class_decisions_hold() {
+        let o = ClassifyOptions::default();
+        let two_pi = 2.0 * std::f64::consts::PI;
+        let n = 40;
+        let series: Vec<(Vec<f64>, Vec<f64>)> = vec![
+            // Period-2 oscillation after a 10-point transient.
+            (
+                (0..n)
+                    .map(|k| {
+                        if k < 10 {
+                            0.1 * k as f64
+                        } else if k % 2 == 0 {
+                            0.5
+                        } else {
+                            -0.4
+                        }
+                    })
+                    .collect(),
+                (0..n)
+                    .map(|k| if k % 2 == 0 { 0.1 } else { -0.2 })
+                    .collect(),
+            ),
+            // Clockwise rotation, settling late.
+            (
+                (0..n)
+                    .map(|k| 0.3 - two_pi * k as f64 + if k < 30 { 0.01 * k as f64 } else { 0.0 })
+                    .collect(),
+                vec![-1.2; n],
+            ),
+            // Rest after motion; rest throughout.
+            (
+                (0..n).map(|k| if k < 5 { 0.2 } else { 0.01 }).collect(),
+                vec![0.0; n],
+            ),
+            (vec![0.01; n], vec![0.0; n]),
+            // Irregular.
+            (
+                (0..n)
+                    .map(|k| ((k * k * 7919) % 101) as f64 * 0.05)
+                    .collect(),
+                (0..n).map(|k| ((k * 31) % 17) as f64 * 0.05).collect(),
+            ),
+        ];
+        let mut decided = 0;
+        for (th, w) in &series {
+            let full = classify_poincare(th, w, &o).class;
+            for class in SteadyClass::ALL {
+                let mut pc = PartialClass::new(n, &o);
+                for k in 0..n {
+                    pc.push(th[k], w[k]);
+                    if let Some(d) = pc.differs_from(class) {
+                        assert_eq!(d, full != class, "{class} vs {full} after {} points", k + 1);
+                        decided += 1;
+                        break;
+                    }
+                }
+            }
+        }
+        assert!(decided >= 10, "{decided}");
     }
 
     #[test]

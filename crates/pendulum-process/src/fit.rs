@@ -6,7 +6,10 @@
 //! the same tail of the capture that classified the measurement) differs from the measured one:
 //! f = Σ_j E_j·(κ if class_j differs else 1). Since every factor is ≥ 1, a partial sum of the E_j
 //! is a lower bound of f, which is what lets a trial be abandoned as soon as it exceeds its target
-//! (the selection is then the same as the plain algorithm's).
+//! (the selection is then the same as the plain algorithm's). To get there early, a bounded
+//! evaluation integrates the window segments with the largest typical error first and then the
+//! tails likeliest to be penalised, and stops a tail once its class is decided; the value is
+//! summed in a fixed order, so it never depends on the bound.
 //!
 //! Free decays (runs aligned as [`crate::AlignmentKind::FreeDecay`]) go through the same objective
 //! with the excitation off. m, l and the inertia are not separable from θ(t) alone, so their
@@ -17,11 +20,14 @@
 //! them by ω0/ω0_est (and velocities by the inverse).
 
 use std::ops::ControlFlow;
+use std::sync::atomic::AtomicU64;
+use std::sync::atomic::Ordering::Relaxed;
+use std::sync::OnceLock;
 
 use pendulum_fit::{Cost, Problem};
 use pendulum_model::{
-    classify_poincare, integrate, ClassifyOptions, Effects, Model, Physical, SimOptions,
-    SteadyClass, SteadyState,
+    classify_poincare, integrate, ClassifyOptions, Effects, Model, PartialClass, Physical,
+    SimOptions, SteadyClass, SteadyState,
 };
 use serde::{Deserialize, Serialize};
 
@@ -379,77 +385,194 @@ impl PreparedRun {
     }
 }
 
-/// Outcome of one run's fit-window simulation.
-enum Window {
-    /// Σ|θ̂ − θ| over the window and the state at its last sample.
+/// First step of every window segment. Each segment starts afresh, so its value does not depend
+/// on which segments were integrated before it (a bounded evaluation integrates the typically
+/// worst ones first); 0.1 is about the step the controller settles on at the fit's tolerance.
+const SEGMENT_H_INIT: f64 = 0.1;
+
+/// One multiple-shooting segment of a run's window: samples `i0..i1`, starting at `t0`.
+#[derive(Debug, Clone, Copy)]
+struct Segment {
+    run: usize,
+    i0: usize,
+    i1: usize,
+    t0: f64,
+    /// The measured restart state (θ rad, dθ/dt dimensionless); `None`: the run's fitted
+    /// initial state at t = 0.
+    y0: Option<[f64; 2]>,
+}
+
+/// The segments of `runs`' windows, run by run, in time order.
+fn segments(runs: &[PreparedRun]) -> Vec<Segment> {
+    let mut out = Vec::new();
+    for (j, run) in runs.iter().enumerate() {
+        let n = run.t.len();
+        if n == 0 {
+            continue;
+        }
+        let first = out.len();
+        out.push(Segment {
+            run: j,
+            i0: 0,
+            i1: n,
+            t0: 0.0,
+            y0: None,
+        });
+        for &(i, y) in &run.restarts {
+            if i > 0 && i < n {
+                let last = out.len() - 1;
+                out[last].i1 = i;
+                out.push(Segment {
+                    run: j,
+                    i0: i,
+                    i1: n,
+                    t0: run.t[i],
+                    y0: Some(y),
+                });
+            }
+        }
+        debug_assert!(out[first..].iter().all(|g| g.i0 < g.i1));
+    }
+    out
+}
+
+/// Outcome of one segment's simulation.
+enum SegmentError {
+    /// Σ|θ̂ − θ| over the segment and the state at its last sample.
     Done(f64, [f64; 2]),
-    /// The partial sum exceeded the bound: the value is that partial sum.
+    /// The sum exceeded the limit: the value is the partial sum.
     Abandoned(f64),
     /// The integration failed.
     Failed,
 }
 
-/// Simulates `model` from `y0` through `run`'s window (θ measured = θ + `offset`); with
-/// restarts, each later segment starts again from its measured state. `k` converts the run's
-/// time unit to the model's (1 except for a free decay with a fitted ω0): times × k, rates / k.
-/// The returned end state is in the model's units.
+/// Simulates one segment of `run` (θ measured = θ + `offset`, the initial state `ic` in measured
+/// coordinates), stopping once the segment's sum exceeds `limit`. `k` converts the run's time
+/// unit to the model's (1 except for a free decay with a fitted ω0): times × k, rates / k. The
+/// returned end state is in the model's units.
 #[allow(clippy::too_many_arguments)]
-fn window_error(
+fn segment_error(
     model: &Model,
     opts: &SimOptions,
     run: &PreparedRun,
-    y0: [f64; 2],
+    seg: &Segment,
+    ic: [f64; 2],
     offset: f64,
-    bound: f64,
+    limit: f64,
     k: f64,
-) -> Window {
+) -> SegmentError {
+    let y = seg.y0.unwrap_or(ic);
     let mut sum = 0.0;
-    let mut end = y0;
-    let n = run.t.len();
-    if n == 0 {
-        return Window::Done(0.0, y0);
-    }
-    // Initial and restart states are in measured coordinates (θ_meas = θ + offset).
-    let mut starts: Vec<(usize, f64, [f64; 2])> = vec![(0, 0.0, [y0[0] - offset, y0[1] / k])];
-    for &(i, y) in &run.restarts {
-        if i > 0 && i < n {
-            starts.push((i, run.t[i] * k, [y[0] - offset, y[1] / k]));
-        }
-    }
-    let mut seg_opts = *opts;
-    for (s, &(i0, t_start, y_start)) in starts.iter().enumerate() {
-        let i1 = starts.get(s + 1).map_or(n, |x| x.0);
-        let t_end = run.t[i1 - 1] * k;
-        let mut j = i0;
-        let res = integrate(
-            model,
-            &seg_opts,
-            t_start,
-            y_start,
-            t_end,
-            run.t[i0..i1].iter().map(|t| t * k),
-            |smp| {
-                sum += (run.theta[j] - (smp.theta + offset)).abs();
-                j += 1;
-                end = [smp.theta, smp.theta_dot];
-                if sum > bound {
-                    ControlFlow::Break(())
-                } else {
-                    ControlFlow::Continue(())
-                }
-            },
-        );
-        match res {
-            Ok(stats) if !stats.stopped_early => {
-                if stats.last_h > 0.0 {
-                    seg_opts.h_init = Some(stats.last_h);
-                }
+    let mut end = [y[0] - offset, y[1] / k];
+    let mut j = seg.i0;
+    let res = integrate(
+        model,
+        &SimOptions {
+            h_init: Some(SEGMENT_H_INIT),
+            ..*opts
+        },
+        seg.t0 * k,
+        [y[0] - offset, y[1] / k],
+        run.t[seg.i1 - 1] * k,
+        run.t[seg.i0..seg.i1].iter().map(|t| t * k),
+        |smp| {
+            sum += (run.theta[j] - (smp.theta + offset)).abs();
+            j += 1;
+            end = [smp.theta, smp.theta_dot];
+            if sum > limit {
+                ControlFlow::Break(())
+            } else {
+                ControlFlow::Continue(())
             }
-            Ok(_) => return Window::Abandoned(sum),
-            Err(_) => return Window::Failed,
-        }
+        },
+    );
+    match res {
+        Ok(stats) if !stats.stopped_early => SegmentError::Done(sum, end),
+        Ok(_) => SegmentError::Abandoned(sum),
+        Err(_) => SegmentError::Failed,
     }
-    Window::Done(sum, end)
+}
+
+/// Integrator tolerance of the steady-state tails (the window's `sim_tol` if looser): 1.4× fewer
+/// steps than 1e-6. A class is decided with tolerances of 0.01–0.05 rad on an attracting orbit,
+/// which 1e-5 resolves as a tight 1e-10 does (test `tail_decision_matches_full_classification`;
+/// 1e-4 lost a rotation there). Through transient chaos no tolerance reproduces the tight class:
+/// on 560 study trial tails 1e-6 agreed with 1e-10 on 379, 1e-5 on 361 (5e-7 … 2e-6: 379–390).
+pub const TAIL_TOL: f64 = 1e-5;
+
+/// Relative margin on a bound before a partial sum computed in another order than the value
+/// counts as exceeding it: sums of ≤ 10⁴ non-negative terms differ by far less with reordering.
+const ORDER_MARGIN: f64 = 1e-11;
+
+/// What a bounded evaluation learns to abandon hopeless trials early: each window segment's
+/// typical error (the largest are integrated first) and how often and at what cost each run's
+/// tail was penalised. Only the order of the work depends on it, never a value, so the fit is the
+/// same whatever it holds (and with any number of threads).
+#[derive(Debug, Default)]
+pub struct WorkOrder {
+    /// Per segment: a running mean of its error (f64 bits).
+    seg_err: OnceLock<Vec<AtomicU64>>,
+    /// Per run: tails simulated, tails penalised, right-hand sides spent on tails.
+    tails: OnceLock<Vec<[AtomicU64; 3]>>,
+}
+
+impl WorkOrder {
+    fn seg_err(&self, n: usize) -> &[AtomicU64] {
+        self.seg_err
+            .get_or_init(|| (0..n).map(|_| AtomicU64::new(0)).collect())
+    }
+
+    fn tails(&self, n: usize) -> &[[AtomicU64; 3]] {
+        self.tails.get_or_init(|| {
+            (0..n)
+                .map(|_| [AtomicU64::new(0), AtomicU64::new(0), AtomicU64::new(0)])
+                .collect()
+        })
+    }
+
+    /// Segment indices, the largest typical error first.
+    fn segment_order(&self, n: usize) -> Vec<usize> {
+        let means: Vec<f64> = self
+            .seg_err(n)
+            .iter()
+            .map(|m| f64::from_bits(m.load(Relaxed)))
+            .collect();
+        let mut order: Vec<usize> = (0..n).collect();
+        order.sort_by(|a, b| means[*b].total_cmp(&means[*a]));
+        order
+    }
+
+    fn record_segment(&self, n: usize, k: usize, e: f64) {
+        // Races lose an update at worst: this only orders the work.
+        let m = &self.seg_err(n)[k];
+        let old = f64::from_bits(m.load(Relaxed));
+        m.store((old + 0.05 * (e - old)).to_bits(), Relaxed);
+    }
+
+    /// Run indices for the tails, the likeliest penalty per unit of work first.
+    fn tail_order(&self, es: &[f64]) -> Vec<usize> {
+        let stats = self.tails(es.len());
+        let score: Vec<f64> = stats
+            .iter()
+            .zip(es)
+            .map(|(c, e)| {
+                let (n, pen, rhs) = (c[0].load(Relaxed), c[1].load(Relaxed), c[2].load(Relaxed));
+                let p = (pen as f64 + 1.0) / (n as f64 + 2.0);
+                let cost = (rhs as f64 + 1.0) / (n as f64 + 1.0);
+                p * e / cost
+            })
+            .collect();
+        let mut order: Vec<usize> = (0..es.len()).collect();
+        order.sort_by(|a, b| score[*b].total_cmp(&score[*a]));
+        order
+    }
+
+    fn record_tail(&self, j: usize, n_runs: usize, penalised: bool, rhs: u64) {
+        let c = &self.tails(n_runs)[j];
+        c[0].fetch_add(1, Relaxed);
+        c[1].fetch_add(u64::from(penalised), Relaxed);
+        c[2].fetch_add(rhs, Relaxed);
+    }
 }
 
 /// The simulated steady state over the run's tail, classified like the measurement
@@ -526,6 +649,72 @@ pub fn simulated_steady(
     Some(s)
 }
 
+/// Whether run j's steady-state penalty applies: [`simulated_steady`]'s class differs from the
+/// measured one. The simulation stops as soon as the Poincaré points so far decide that (see
+/// [`PartialClass`]), e.g. a trial that turns the wrong way or never repeats. Also returns the
+/// right-hand-side evaluations spent.
+fn tail_penalised(
+    model: &Model,
+    opts: &SimOptions,
+    run: &PreparedRun,
+    t_from: f64,
+    y_from: [f64; 2],
+    k: f64,
+) -> (bool, u64) {
+    if run.free {
+        // A free decay's tail is classified whole (rest or swinging): no early decision.
+        let st = simulated_steady(model, opts, run, t_from, y_from, k);
+        return (st.is_none_or(|s| s.class != run.steady.class), 0);
+    }
+    let q = 0.25 * run.period();
+    let mut times: Vec<f64> = Vec::with_capacity(run.tail_t.len() * 2);
+    for &t in &run.tail_t {
+        if t >= t_from {
+            times.push(t);
+            times.push(t + q);
+        }
+    }
+    let Some(&t_end) = times.last().filter(|_| times.len() >= 4) else {
+        return (true, 0);
+    };
+    let n = times.len() / 2;
+    let mut partial = PartialClass::new(n, &run.classify);
+    let mut first = 0.0;
+    let mut decided = None;
+    let mut k = 0;
+    let stats = integrate(
+        model,
+        opts,
+        t_from,
+        y_from,
+        t_end,
+        times.iter().copied(),
+        |s| {
+            k += 1;
+            if k % 2 == 1 {
+                first = s.theta;
+                return ControlFlow::Continue(());
+            }
+            // Exactly as simulated_steady forms the points.
+            partial.push(first, (s.theta - first) / q);
+            decided = partial.differs_from(run.steady.class);
+            if decided.is_some() {
+                ControlFlow::Break(())
+            } else {
+                ControlFlow::Continue(())
+            }
+        },
+    );
+    let Ok(stats) = stats else {
+        return (true, 0);
+    };
+    let differs = decided.unwrap_or_else(|| {
+        let (a, b) = partial.points();
+        classify_poincare(a, b, &run.classify).class != run.steady.class
+    });
+    (differs, stats.rhs_evals)
+}
+
 /// The model of a physical parameter set, driven by the aligned crank (φ = ωt at t = 0), with
 /// `accel_delay` shifting the forcing: the accelerometer's peak came Δ after the true one, so the
 /// true crank angle is ω(t + Δ).
@@ -556,6 +745,8 @@ pub struct StudyObjective<'a> {
     pub fixed_params: Option<Vec<f64>>,
     /// Whether to apply the steady-state penalty.
     pub penalty: bool,
+    /// Learned order of a bounded evaluation's work (start with `WorkOrder::default()`).
+    pub order: WorkOrder,
 }
 
 /// The breakdown of one evaluation.
@@ -587,9 +778,14 @@ impl StudyObjective<'_> {
         }
     }
 
-    /// The model of run j for parameters p.
+    /// The model of run j for parameters p (crank tabulated: this is the fit's inner loop).
     pub fn model_of(&self, run: &PreparedRun, p: &[f64]) -> Model {
-        self.spec.run_model(run, p)
+        let m = self.spec.run_model(run, p);
+        if run.free {
+            m
+        } else {
+            m.with_crank_table()
+        }
     }
 
     fn offset(&self, p: &[f64]) -> f64 {
@@ -604,36 +800,137 @@ impl StudyObjective<'_> {
             )
     }
 
+    /// Every segment's error in `order` (stopping once their sum exceeds `limit`), into `seg_e`
+    /// and each run's end state into `ends`. `Err` carries the cost to report when stopped.
+    #[allow(clippy::too_many_arguments)]
+    fn windows(
+        &self,
+        models: &[Model],
+        ks: &[f64],
+        segs: &[Segment],
+        order: &[usize],
+        ics: &[f64],
+        off: f64,
+        limit: f64,
+        seg_e: &mut [f64],
+        ends: &mut [[f64; 2]],
+    ) -> Result<(), Cost> {
+        let mut done = 0.0;
+        for &k in order {
+            let g = &segs[k];
+            let ic = [ics[2 * g.run], ics[2 * g.run + 1]];
+            let run = &self.runs[g.run];
+            match segment_error(
+                &models[g.run],
+                &self.sim,
+                run,
+                g,
+                ic,
+                off,
+                limit - done,
+                ks[g.run],
+            ) {
+                SegmentError::Done(e, end) => {
+                    seg_e[k] = e;
+                    done += e;
+                    if g.i1 == run.t.len() {
+                        ends[g.run] = end;
+                    }
+                    self.order.record_segment(segs.len(), k, e);
+                }
+                SegmentError::Abandoned(partial) => return Err(Cost::AtLeast(done + partial)),
+                SegmentError::Failed => return Err(Cost::Exact(FAILED_COST)),
+            }
+        }
+        Ok(())
+    }
+
+    /// Integrator settings of the steady-state tails: the fit's, loosened to [`TAIL_TOL`].
+    pub fn tail_sim(&self) -> SimOptions {
+        SimOptions {
+            rtol: self.sim.rtol.max(TAIL_TOL),
+            atol: self.sim.atol.max(TAIL_TOL),
+            ..self.sim
+        }
+    }
+
+    /// Each run's fitted initial state in the model's coordinates (its end state when its window
+    /// has no samples).
+    fn initial_states(&self, ics: &[f64], off: f64, ks: &[f64]) -> Vec<[f64; 2]> {
+        (0..self.runs.len())
+            .map(|j| [ics[2 * j] - off, ics[2 * j + 1] / ks[j]])
+            .collect()
+    }
+
+    /// Each run's E_θ: its segments' errors summed in time order (whatever order they were
+    /// integrated in, so the value does not depend on it).
+    fn per_run(&self, segs: &[Segment], seg_e: &[f64]) -> Vec<f64> {
+        let mut es = vec![0.0; self.runs.len()];
+        for (g, e) in segs.iter().zip(seg_e) {
+            es[g.run] += e;
+        }
+        es
+    }
+
     /// Full evaluation with the per-run breakdown (no abandoning).
     pub fn evaluate(&self, x: &[f64]) -> Evaluation {
         let (p, ics) = self.split(x);
         let off = self.offset(&p);
+        let models: Vec<Model> = self.runs.iter().map(|r| self.model_of(r, &p)).collect();
+        let ks: Vec<f64> = self
+            .runs
+            .iter()
+            .map(|r| self.spec.time_scale(r, &p))
+            .collect();
+        let segs = segments(self.runs);
+        let mut seg_e = vec![0.0; segs.len()];
+        let mut ends = self.initial_states(ics, off, &ks);
+        let mut failed = vec![false; self.runs.len()];
+        // Run by run, so that a failed integration costs only its run.
+        for (k, g) in segs.iter().enumerate() {
+            let ic = [ics[2 * g.run], ics[2 * g.run + 1]];
+            let run = &self.runs[g.run];
+            match segment_error(
+                &models[g.run],
+                &self.sim,
+                run,
+                g,
+                ic,
+                off,
+                f64::INFINITY,
+                ks[g.run],
+            ) {
+                SegmentError::Done(e, end) => {
+                    seg_e[k] = e;
+                    if g.i1 == run.t.len() {
+                        ends[g.run] = end;
+                    }
+                }
+                SegmentError::Abandoned(_) | SegmentError::Failed => failed[g.run] = true,
+            }
+        }
+        let es = self.per_run(&segs, &seg_e);
         let mut per_run_e = Vec::new();
         let mut steadies = Vec::new();
         let mut f = 0.0;
         for (j, run) in self.runs.iter().enumerate() {
-            let model = self.model_of(run, &p);
-            let k = self.spec.time_scale(run, &p);
-            let y0 = [ics[2 * j], ics[2 * j + 1]];
-            match window_error(&model, &self.sim, run, y0, off, f64::INFINITY, k) {
-                Window::Done(e, end) => {
-                    let t_last = *run.t.last().unwrap_or(&0.0) * k;
-                    let st = simulated_steady(&model, &self.sim, run, t_last, end, k);
-                    let differs = st.is_none_or(|s| s.class != run.steady.class);
-                    f += if self.penalty && differs {
-                        self.kappa * e
-                    } else {
-                        e
-                    };
-                    per_run_e.push(e);
-                    steadies.push(st);
-                }
-                Window::Abandoned(_) | Window::Failed => {
-                    per_run_e.push(FAILED_COST);
-                    steadies.push(None);
-                    f += FAILED_COST;
-                }
+            if failed[j] {
+                per_run_e.push(FAILED_COST);
+                steadies.push(None);
+                f += FAILED_COST;
+                continue;
             }
+            let e = es[j];
+            let t_last = *run.t.last().unwrap_or(&0.0) * ks[j];
+            let st = simulated_steady(&models[j], &self.tail_sim(), run, t_last, ends[j], ks[j]);
+            let differs = st.is_none_or(|s| s.class != run.steady.class);
+            f += if self.penalty && differs {
+                self.kappa * e
+            } else {
+                e
+            };
+            per_run_e.push(e);
+            steadies.push(st);
         }
         Evaluation {
             f_obj: f,
@@ -681,6 +978,10 @@ impl Problem for StudyObjective<'_> {
         b
     }
 
+    /// The work is ordered to exceed `bound` as early as possible (see [`WorkOrder`]): window
+    /// segments with the largest typical error first, then the tails likeliest to be penalised
+    /// per unit of work. The value itself is summed in a fixed order, so it does not depend on
+    /// the bound; a partial sum counts as exceeding the bound only beyond [`ORDER_MARGIN`].
     fn cost(&self, x: &[f64], bound: f64) -> Cost {
         let (p, ics) = self.split(x);
         let off = self.offset(&p);
@@ -690,44 +991,51 @@ impl Problem for StudyObjective<'_> {
             .iter()
             .map(|r| self.spec.time_scale(r, &p))
             .collect();
-        let mut es = Vec::with_capacity(self.runs.len());
-        let mut ends = Vec::with_capacity(self.runs.len());
-        let mut total = 0.0;
-        for (j, run) in self.runs.iter().enumerate() {
-            let y0 = [ics[2 * j], ics[2 * j + 1]];
-            match window_error(&models[j], &self.sim, run, y0, off, bound - total, ks[j]) {
-                Window::Done(e, end) => {
-                    total += e;
-                    es.push(e);
-                    ends.push(end);
-                }
-                // The true cost is ≥ total + partial > bound; report a value strictly above bound.
-                Window::Abandoned(partial) => {
-                    return Cost::AtLeast((total + partial).max(bound.next_up()));
-                }
-                Window::Failed => {
-                    return if FAILED_COST > bound {
-                        Cost::AtLeast(FAILED_COST)
-                    } else {
-                        Cost::Exact(FAILED_COST)
-                    };
-                }
+        let limit = bound + ORDER_MARGIN * bound.abs();
+        let segs = segments(self.runs);
+        let order = self.order.segment_order(segs.len());
+        let mut seg_e = vec![0.0; segs.len()];
+        let mut ends = self.initial_states(ics, off, &ks);
+        if let Err(c) = self.windows(
+            &models, &ks, &segs, &order, ics, off, limit, &mut seg_e, &mut ends,
+        ) {
+            return match c {
+                // The true cost is ≥ the partial sum > bound; report a value strictly above bound.
+                Cost::AtLeast(v) => Cost::AtLeast(v.max(bound.next_up())),
+                Cost::Exact(v) if v > bound => Cost::AtLeast(v),
+                c => c,
+            };
+        }
+        let es = self.per_run(&segs, &seg_e);
+        let total: f64 = es.iter().sum();
+        if !(self.penalty && self.kappa > 1.0) {
+            return Cost::Exact(total);
+        }
+        let tail_sim = self.tail_sim();
+        let mut penalised = vec![false; self.runs.len()];
+        let mut lower = total;
+        for j in self.order.tail_order(&es) {
+            if lower > limit {
+                return Cost::AtLeast(lower.max(bound.next_up()));
+            }
+            let run = &self.runs[j];
+            let t_last = *run.t.last().unwrap_or(&0.0) * ks[j];
+            let (pen, rhs) = tail_penalised(&models[j], &tail_sim, run, t_last, ends[j], ks[j]);
+            penalised[j] = pen;
+            self.order
+                .record_tail(j, self.runs.len(), penalised[j], rhs);
+            if penalised[j] {
+                lower += (self.kappa - 1.0) * es[j];
             }
         }
-        if self.penalty && self.kappa > 1.0 {
-            for (j, run) in self.runs.iter().enumerate() {
-                if total > bound {
-                    return Cost::AtLeast(total.max(bound.next_up()));
-                }
-                let t_last = *run.t.last().unwrap_or(&0.0) * ks[j];
-                let st = simulated_steady(&models[j], &self.sim, run, t_last, ends[j], ks[j]);
-                if st.is_none_or(|s| s.class != run.steady.class) {
-                    total += (self.kappa - 1.0) * es[j];
-                }
+        let mut f = total;
+        for (e, pen) in es.iter().zip(&penalised) {
+            if *pen {
+                f += (self.kappa - 1.0) * e;
             }
         }
         // Exact even when above the bound: the driver only needs AtLeast to be a lower bound.
-        Cost::Exact(total)
+        Cost::Exact(f)
     }
 }
 
@@ -735,4 +1043,165 @@ impl Problem for StudyObjective<'_> {
 /// reaches as period 2 or 4 is the same kind of motion for a harvester).
 pub fn classes_agree(a: SteadyClass, b: SteadyClass) -> bool {
     a == b
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const STUDY: [f64; 3] = [0.0, 0.5, 0.15];
+
+    fn rig() -> RigParams {
+        RigParams {
+            m_kg: 1.46,
+            l_m: 0.265,
+            crank_r_m: 0.0725,
+            rod_l_m: 0.575,
+            r_b_m: 0.01225,
+            omega_hz: Some(1.75),
+            g_m_s2: 9.81,
+        }
+    }
+
+    /// A run whose "measurement" is the model's own tight simulation from `y0`: a 5 s window at
+    /// 100 Hz in 0.5 s segments, the tail over 40–60 s.
+    fn run(omega_hz: f64, p: [f64; 3], y0: [f64; 2]) -> PreparedRun {
+        let rig = rig();
+        let w0 = rig.omega0_rad_s();
+        let model = Model::new(
+            ModelSpec::reference()
+                .physical(&rig, omega_hz, &p)
+                .to_dimensionless(),
+        );
+        let t: Vec<f64> = (0..500).map(|k| w0 * k as f64 * 0.01).collect();
+        let (mut theta, mut state) = (Vec::new(), Vec::new());
+        integrate(
+            &model,
+            &SimOptions::with_tol(1e-10),
+            0.0,
+            y0,
+            t[t.len() - 1],
+            t.iter().copied(),
+            |s| {
+                theta.push(s.theta);
+                state.push([s.theta, s.theta_dot]);
+                ControlFlow::Continue(())
+            },
+        )
+        .unwrap();
+        let period = w0 / omega_hz;
+        let tail_t = (0..)
+            .map(|k| w0 * 40.0 + k as f64 * period)
+            .take_while(|t| *t <= w0 * 60.0 - 0.25 * period)
+            .collect();
+        PreparedRun {
+            id: "test".into(),
+            role: Role::Identify,
+            rig,
+            omega_hz,
+            restarts: (1..10).map(|s| (50 * s, state[50 * s])).collect(),
+            t,
+            theta,
+            ic_est: y0,
+            steady: SteadyState {
+                class: SteadyClass::Chaos,
+                period: 0,
+                mean_theta_dot: 0.0,
+            },
+            tail_t,
+            free: false,
+            omega0_rad_s: w0,
+            classify: ClassifyOptions {
+                theta_tol: 0.05,
+                theta_dot_tol: 0.05 / (0.25 * period),
+                max_period: 16,
+                rest_tol: 0.01,
+            },
+        }
+    }
+
+    /// Parameter sets and starts with robust classes: stuck at rest, oscillation, rotation.
+    fn cases() -> Vec<PreparedRun> {
+        vec![
+            run(1.3, STUDY, [0.5, 0.0]),
+            run(1.3, [0.0, 0.2, 0.24], [0.2, 0.0]),
+            run(1.0, [0.0, 0.3, 0.02], [0.3, 0.0]),
+            run(1.75, STUDY, [1.0, -1.5]),
+            run(1.75, [0.01, 0.4, 0.1], [1.0, 1.5]),
+            run(1.65, STUDY, [0.5, 0.0]),
+        ]
+    }
+
+    /// The early-stopping tail decides the penalty exactly as classifying the whole tail does,
+    /// for every measured class; and the fit tolerance's class is the tight reference's.
+    #[test]
+    fn tail_decision_matches_full_classification() {
+        let opts = SimOptions::with_tol(TAIL_TOL);
+        let mut seen = Vec::new();
+        for r in cases() {
+            let model = Model::new(
+                ModelSpec::reference()
+                    .physical(&r.rig, r.omega_hz, &STUDY)
+                    .to_dimensionless(),
+            )
+            .with_crank_table();
+            let y = [0.2, 0.0];
+            let full = simulated_steady(&model, &opts, &r, 5.0, y, 1.0)
+                .unwrap()
+                .class;
+            let tight = simulated_steady(&model, &SimOptions::with_tol(1e-10), &r, 5.0, y, 1.0)
+                .unwrap()
+                .class;
+            assert_eq!(full, tight, "ω = {} Hz", r.omega_hz);
+            seen.push(full);
+            for class in SteadyClass::ALL {
+                let mut r = r.clone();
+                r.steady.class = class;
+                let (penalised, _) = tail_penalised(&model, &opts, &r, 5.0, y, 1.0);
+                assert_eq!(penalised, full != class, "{full} measured as {class}");
+            }
+        }
+        eprintln!("classes: {seen:?}");
+        assert!(seen.contains(&SteadyClass::Rest) && seen.iter().any(|c| c.is_rotation()));
+    }
+
+    /// A bounded cost is the unbounded one, or a lower bound above the bound when that is
+    /// above the bound: the early abandon cannot change a selection.
+    #[test]
+    fn bounded_cost_is_exact() {
+        let runs = cases();
+        let spec = ModelSpec::reference();
+        let objective = StudyObjective {
+            runs: &runs,
+            spec: &spec,
+            kappa: 2.0,
+            sim: SimOptions::with_tol(1e-6),
+            ic_halfwidth: 0.1,
+            fixed_params: None,
+            penalty: true,
+            order: WorkOrder::default(),
+        };
+        let bounds = objective.bounds();
+        let mut u = 0.37_f64;
+        for _ in 0..12 {
+            let x: Vec<f64> = bounds
+                .iter()
+                .map(|(lo, hi)| {
+                    u = (u * 997.0 + 0.123).fract();
+                    lo + (hi - lo) * u
+                })
+                .collect();
+            let Cost::Exact(v) = objective.cost(&x, f64::INFINITY) else {
+                panic!("unbounded cost must be exact");
+            };
+            for b in [0.3 * v, v.next_down(), v, 2.0 * v] {
+                match objective.cost(&x, b) {
+                    Cost::Exact(w) => assert_eq!(w.to_bits(), v.to_bits()),
+                    Cost::AtLeast(w) => assert!(w > b && v > b && w <= v, "{w} {v} {b}"),
+                }
+            }
+            let f = objective.evaluate(&x).f_obj;
+            assert!((f - v).abs() <= 1e-9 * v, "{f} vs {v}");
+        }
+    }
 }

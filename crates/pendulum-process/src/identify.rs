@@ -334,6 +334,7 @@ pub fn identify(
         ic_halfwidth: cfg.ic_halfwidth,
         fixed_params: None,
         penalty: true,
+        order: Default::default(),
     };
     let dim = spec.params.len() + 2 * runs.len();
     let np = cfg.np.unwrap_or(10 * dim).max(4);
@@ -507,6 +508,7 @@ pub fn validate(
                 ic_halfwidth: cfg.ic_halfwidth,
                 fixed_params: Some(params.to_vec()),
                 penalty: false,
+                order: Default::default(),
             };
             let de = DeConfig {
                 np: cfg.np,
