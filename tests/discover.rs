@@ -319,3 +319,36 @@ fn regression_issue_5_dry_base_finds_viscous_drag() {
     let s = discover(151, Base::Dry, 0.0, b, 0.15, "");
     assert_found(&s, "viscous_linear", b, 0.25, 0.0);
 }
+
+/// A pair: two effects hidden together must both be named (and nothing else).
+#[test]
+fn regression_issue_5_finds_a_pair() {
+    let mut r = rng(13);
+    let d = r.random_range(0.02..0.08) * if r.random::<bool>() { 1.0 } else { -1.0 };
+    let j = r.random_range(0.005..0.02);
+    let s = discover(
+        157,
+        Base::Reference,
+        0.0,
+        0.5,
+        0.15,
+        &format!("horizontal_base_delta_rad = {d}\nextra_inertia_j_kg_m2 = {j}"),
+    );
+    let mut accepted: Vec<&str> = s
+        .discovery
+        .rows
+        .iter()
+        .filter(|r| r.accepted)
+        .map(|r| r.effect.as_str())
+        .collect();
+    accepted.sort_unstable();
+    assert_eq!(accepted, vec!["extra_inertia", "horizontal_base"]);
+    for (effect, truth) in [("horizontal_base", d), ("extra_inertia", j)] {
+        let row = s.discovery.rows.iter().find(|r| r.effect == effect).unwrap();
+        assert!(
+            (row.estimate - truth).abs() <= 0.25 * truth.abs(),
+            "{effect}: estimate {} vs truth {truth}",
+            row.estimate
+        );
+    }
+}
