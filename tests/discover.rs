@@ -344,7 +344,12 @@ fn regression_issue_5_finds_a_pair() {
     accepted.sort_unstable();
     assert_eq!(accepted, vec!["extra_inertia", "horizontal_base"]);
     for (effect, truth) in [("horizontal_base", d), ("extra_inertia", j)] {
-        let row = s.discovery.rows.iter().find(|r| r.effect == effect).unwrap();
+        let row = s
+            .discovery
+            .rows
+            .iter()
+            .find(|r| r.effect == effect)
+            .unwrap();
         assert!(
             (row.estimate - truth).abs() <= 0.25 * truth.abs(),
             "{effect}: estimate {} vs truth {truth}",

@@ -158,3 +158,53 @@ fn regression_issue_4_linear_data_gives_mu_near_zero() {
     assert!(mu < 0.01, "mu = {mu}");
     assert!((b / 0.3 - 1.0).abs() < 0.10, "b = {b}");
 }
+
+/// Issue 6 item 3: re-running on the MCAP files gives the same answer as on the raw captures
+/// (ingest loses nothing the fit uses): identical fitted parameters, E_θ and steady states.
+#[test]
+fn regression_issue_6_identify_same_from_mcap_as_from_raw() {
+    let dir = tempfile::tempdir().unwrap();
+    let camp = dir.path().join("campaign");
+    make_campaign(&camp, &campaign_toml(61, 0.0, 0.5, 0.15));
+    let mcap = dir.path().join("mcap");
+    pendulum_jobs::ingest::run(&camp, &mcap, false).unwrap();
+    let job = |input: &Path, out: &Path| IdentifyJob {
+        input: input.to_path_buf(),
+        out: out.to_path_buf(),
+        pipeline: None,
+        overrides: FitOverrides {
+            generations: Some(40),
+            ..FitOverrides::default()
+        },
+        progress: false,
+    };
+    let (out_raw, out_mcap) = (dir.path().join("raw-out"), dir.path().join("mcap-out"));
+    run(&job(&camp, &out_raw)).unwrap();
+    run(&job(&mcap, &out_mcap)).unwrap();
+    for col in ["a", "b", "mu", "f_obj", "e_theta"] {
+        let (x, y) = (
+            column_f64(&out_raw.join("params.parquet"), col),
+            column_f64(&out_mcap.join("params.parquet"), col),
+        );
+        assert!(
+            !x.is_empty() && x.len() == y.len(),
+            "{col}: {} vs {} rows",
+            x.len(),
+            y.len()
+        );
+        for (u, v) in x.iter().zip(&y) {
+            assert!(u.to_bits() == v.to_bits(), "{col}: raw {u} vs mcap {v}");
+        }
+    }
+    for col in ["measured_steady", "omega_hz"] {
+        let f = |d: &Path| -> Vec<String> {
+            let p = d.join("runs.parquet");
+            if col == "omega_hz" {
+                column_f64(&p, col).iter().map(|v| v.to_string()).collect()
+            } else {
+                column_str(&p, col)
+            }
+        };
+        assert_eq!(f(&out_raw), f(&out_mcap), "runs.parquet {col}");
+    }
+}
