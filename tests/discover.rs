@@ -284,6 +284,17 @@ fn regression_issue_5_finds_speed_drift() {
         &format!("speed_drift_hz_per_s = {d}"),
     );
     assert_found(&s, "speed_drift", d, 0.25, 0.0);
+    // The extended model carries the drift and its re-aligned runs, and replays them better.
+    let ext = s.discovery.extended.as_ref().expect("extended model");
+    assert!(ext.spec.name.ends_with("+speed_drift"), "{}", ext.spec.name);
+    assert!(!ext.alignments.is_empty());
+    let e = |v: &[pendulum_process::identify::RunFit]| v.iter().map(|r| r.e_theta).sum::<f64>();
+    assert!(
+        e(&s.discovery.validation_final) < e(&s.discovery.validation_base),
+        "validate E_θ {} (extended) vs {} (base)",
+        e(&s.discovery.validation_final),
+        e(&s.discovery.validation_base)
+    );
 }
 
 /// Survey (slow, by hand with `--ignored`): campaigns with nothing hidden, drawn damping and

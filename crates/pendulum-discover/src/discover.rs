@@ -361,8 +361,8 @@ fn realigned(ctx: &Context, ev: &DriftEvidence) -> Result<Context, ProcessError>
 /// When that evidence is significant, the extended model (the runs re-aligned on the drifting
 /// phase, dΩ/dτ a fitted parameter) is refitted on the identify runs and validated like any
 /// candidate against the base refitted the same way; it is accepted when the validate runs'
-/// E_θ falls by more than the candidates' noise rule. (The extended model of the outputs does
-/// not carry it: its residual series use the constant-speed alignment.)
+/// E_θ falls by more than the candidates' noise rule. Accepted, it becomes the model the other
+/// candidates extend, with its re-aligned runs (`FitOutcome::alignments`).
 #[allow(clippy::too_many_arguments)]
 fn speed_drift_row(
     ev: &DriftEvidence,
@@ -373,7 +373,7 @@ fn speed_drift_row(
     val_runs: &[PreparedRun],
     ics: &[f64],
     gain_needed: f64,
-) -> Result<DiagnosisRow, ProcessError> {
+) -> Result<(DiagnosisRow, Option<DriftModel>), ProcessError> {
     let (n, est, half) = (ev.n, ev.est, ev.half);
     let mut row = DiagnosisRow {
         effect: "speed_drift".into(),
@@ -390,7 +390,7 @@ fn speed_drift_row(
         note: format!("crank fits with a drifting speed on {n} identify runs; screened out"),
     };
     let Some(ctx2) = ctx2.filter(|_| ev.significant && !base_fit.spec.params.is_empty()) else {
-        return Ok(row);
+        return Ok((row, None));
     };
     let id2 = ctx2.prepared(Role::Identify, &cfg.validate.window, "discover")?;
     let val2 = ctx2.prepared(Role::Validate, &cfg.validate.window, "discover")?;
@@ -424,7 +424,64 @@ fn speed_drift_row(
         x.last().copied().unwrap_or(f64::NAN),
         gain_needed
     );
-    Ok(row)
+    if !row.accepted {
+        return Ok((row, None));
+    }
+    let objective = StudyObjective {
+        runs: &id2,
+        spec: &spec,
+        kappa: 2.0,
+        sim: pendulum_model::SimOptions::with_tol(1e-6),
+        ic_halfwidth: 0.1,
+        fixed_params: None,
+        penalty: true,
+        order: Default::default(),
+    };
+    let mut full = x.clone();
+    full.extend_from_slice(&ics2);
+    let eval = objective.evaluate(&full);
+    let outcome = FitOutcome {
+        spec: spec.clone(),
+        params: x,
+        f_obj: eval.f_obj,
+        e_theta: eval.e_theta,
+        runs: base_fit
+            .runs
+            .iter()
+            .zip(&id2)
+            .enumerate()
+            .map(|(j, (r, p))| RunFit {
+                ic_est: p.ic_est,
+                ic_fit: p.ic_est,
+                e_theta: eval.per_run_e[j],
+                simulated: eval.per_run_sim_steady[j],
+                ..r.clone()
+            })
+            .collect(),
+        convergence: Vec::new(),
+        stop_reason: "refit (Nelder–Mead, runs re-aligned on the drifting crank speed)".into(),
+        alignments: ctx2.alignments.clone(),
+        ..base_fit.clone()
+    };
+    Ok((
+        row,
+        Some(DriftModel {
+            outcome,
+            id_runs: id2,
+            val_runs: val2,
+            ics: ics2,
+            validation: val,
+        }),
+    ))
+}
+
+/// The model extended with `speed_drift` and the re-aligned runs it was fitted on.
+struct DriftModel {
+    outcome: FitOutcome,
+    id_runs: Vec<PreparedRun>,
+    val_runs: Vec<PreparedRun>,
+    ics: Vec<f64>,
+    validation: Vec<RunFit>,
 }
 
 /// The extended model spec and the initial values of its new parameters.
@@ -594,8 +651,8 @@ pub fn discover(
             field: "fit".into(),
             message: "no base fit: the pipeline needs a fit stage before discover".into(),
         })?;
-    let id_runs = ctx.prepared(Role::Identify, &cfg.validate.window, "discover")?;
-    let val_runs = ctx.prepared(Role::Validate, &cfg.validate.window, "discover")?;
+    let mut id_runs = ctx.prepared(Role::Identify, &cfg.validate.window, "discover")?;
+    let mut val_runs = ctx.prepared(Role::Validate, &cfg.validate.window, "discover")?;
     let first = ctx
         .runs
         .iter()
@@ -689,11 +746,33 @@ pub fn discover(
     let noise = ((e1 - e2).abs() / e1.min(e2).max(1e-12)).max(0.0);
     let gain_needed = cfg.gain_min.max(3.0 * noise);
 
-    // Confirm the chosen candidates in order.
+    // Confirm the chosen candidates in order (after a speed drift, which changes the runs'
+    // alignment and so comes first).
     let n_base = base_fit.spec.params.len();
-    let ics: Vec<f64> = base_fit.runs.iter().flat_map(|r| r.ic_fit).collect();
+    let mut ics: Vec<f64> = base_fit.runs.iter().flat_map(|r| r.ic_fit).collect();
     let mut current = base_fit.clone();
     let mut current_val = if e1 <= e2 { v1.clone() } else { v2.clone() };
+    let mut drift_row = None;
+    if let Some(ev) = &drift {
+        let (row, model) = speed_drift_row(
+            ev,
+            ctx_drift.as_ref(),
+            cfg,
+            &base_fit,
+            &id_runs,
+            &val_runs,
+            &ics,
+            gain_needed,
+        )?;
+        drift_row = Some(row);
+        if let Some(m) = model {
+            current = m.outcome;
+            current_val = m.validation;
+            id_runs = m.id_runs;
+            val_runs = m.val_runs;
+            ics = m.ics;
+        }
+    }
     let mut current_cols = base.columns();
     current_cols.extend(screened.nuisance.iter().copied());
     let mut baseline: Option<Vec<RunFit>> = None;
@@ -826,7 +905,7 @@ pub fn discover(
                 params: x.clone(),
                 f_obj: eval.f_obj,
                 e_theta: eval.e_theta,
-                runs: base_fit
+                runs: current
                     .runs
                     .iter()
                     .enumerate()
@@ -838,7 +917,7 @@ pub fn discover(
                     .collect(),
                 convergence: Vec::new(),
                 stop_reason: "refit (Nelder–Mead from the base fit)".into(),
-                ..base_fit.clone()
+                ..current.clone()
             };
             current_val = val;
             current_cols = cols;
@@ -941,17 +1020,7 @@ pub fn discover(
             .unwrap_or(rows.len());
         rows.insert(at, row);
     }
-    if let Some(ev) = &drift {
-        let row = speed_drift_row(
-            ev,
-            ctx_drift.as_ref(),
-            cfg,
-            &base_fit,
-            &id_runs,
-            &val_runs,
-            &ics,
-            gain_needed,
-        )?;
+    if let Some(row) = drift_row {
         let at = rows
             .iter()
             .position(|r| r.effect == "unexplained")

@@ -455,6 +455,7 @@ fn free_decays(
                 convergence: Vec::new(),
                 runs: Vec::new(),
                 polished: None,
+                alignments: Default::default(),
             },
             extended: None,
             rows: Vec::new(),

@@ -141,7 +141,12 @@ pub fn residuals_of(
         let Some(run) = ctx.runs.iter().find(|r| r.id == rf.id) else {
             continue;
         };
-        let Some(al) = ctx.alignments.get(&rf.id) else {
+        // A model fitted on re-aligned runs (speed_drift) is replayed on its own alignment.
+        let Some(al) = fit
+            .alignments
+            .get(&rf.id)
+            .or_else(|| ctx.alignments.get(&rf.id))
+        else {
             continue;
         };
         let series = residual_series(run, al, &fit.spec, &fit.params, rf.ic_fit, &window, span_s)?;

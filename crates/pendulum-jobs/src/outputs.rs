@@ -328,6 +328,7 @@ pub fn read_params(path: &Path, model: Option<&str>) -> Result<FitOutcome, JobEr
                 convergence: Vec::new(),
                 runs: Vec::new(),
                 polished: None,
+                alignments: Default::default(),
             });
         }
     }

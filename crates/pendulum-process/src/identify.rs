@@ -296,6 +296,10 @@ pub struct FitOutcome {
     pub runs: Vec<RunFit>,
     /// Polished parameters and objective, when a polish ran.
     pub polished: Option<(Vec<f64>, f64, usize)>,
+    /// Runs whose alignment this model was fitted on differs from the pipeline's (re-aligned on
+    /// a drifting crank speed, `speed_drift`); empty for every other model.
+    #[serde(default, skip_serializing_if = "std::collections::BTreeMap::is_empty")]
+    pub alignments: std::collections::BTreeMap<String, crate::Alignment>,
 }
 
 impl FitOutcome {
@@ -408,6 +412,7 @@ pub fn identify(
             .collect(),
         runs: run_fits,
         polished: polished.map(|(x, f, k)| (x[..n].to_vec(), f, k)),
+        alignments: Default::default(),
         spec,
     })
 }
