@@ -239,12 +239,18 @@ fn survey_issue_5_constant_dry_torque_hit_rate() {
             .filter(|r| r.accepted)
             .map(|r| r.effect.as_str())
             .collect();
-        let est = s
+        let row = s
             .discovery
             .rows
             .iter()
-            .find(|r| r.effect == "coulomb_constant")
-            .map_or(f64::NAN, |r| r.estimate);
+            .find(|r| r.effect == "coulomb_constant");
+        let est = row.map_or(f64::NAN, |r| r.estimate);
+        if let Some(r) = row {
+            eprintln!(
+                "survey k={k} ΔBIC {:.1}, held-out gain {:.3}; {}",
+                r.delta_bic, r.heldout_gain, r.note
+            );
+        }
         let hit = accepted == ["coulomb_constant"];
         hits += usize::from(hit);
         eprintln!(

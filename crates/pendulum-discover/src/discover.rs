@@ -796,6 +796,20 @@ pub fn discover(
                     .unwrap_or_else(|| current.param(*p))
             })
             .collect();
+        // The base's damping terms start from the screen's joint estimate with the candidate in,
+        // not from the base fit, whose terms absorbed what the candidate now explains (a
+        // constant dry torque inflates μ): a local refit from there need not find its way back.
+        for (i, p) in spec.params.iter().enumerate() {
+            let si = match p {
+                FitParam::B => fit.coef_of(0).map(|(v, _)| v * s.m * s.w0),
+                FitParam::A => fit.coef_of(1).map(|(v, _)| v * s.m / s.l),
+                FitParam::Mu => fit.coef_of(2).map(|(v, _)| v * s.l / s.r_b),
+                _ => None,
+            };
+            if let Some(v) = si.filter(|v| v.is_finite()) {
+                x0[i] = v.max(0.0);
+            }
+        }
         // bearing_load_base_accel refits μ on the new load.
         if c.effect == "bearing_load_base_accel" {
             if let Some(i) = spec.params.iter().position(|p| *p == FitParam::Mu) {
