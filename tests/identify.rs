@@ -44,6 +44,7 @@ fn identify(dir: &Path, out: &Path, model: &str) -> pendulum_jobs::outputs::Outp
             ..FitOverrides::default()
         },
         progress: false,
+        free_segments: false,
     })
     .unwrap()
 }
@@ -177,6 +178,7 @@ fn regression_issue_6_identify_same_from_mcap_as_from_raw() {
             ..FitOverrides::default()
         },
         progress: false,
+        free_segments: false,
     };
     let (out_raw, out_mcap) = (dir.path().join("raw-out"), dir.path().join("mcap-out"));
     run(&job(&camp, &out_raw)).unwrap();
@@ -207,4 +209,45 @@ fn regression_issue_6_identify_same_from_mcap_as_from_raw() {
         };
         assert_eq!(f(&out_raw), f(&out_mcap), "runs.parquet {col}");
     }
+}
+
+/// Issue 7 item 2: the free-motion segment before each shaker start goes through the same
+/// stages as a free decay (excitation off, identifiable terms) and recovers the twin's truth:
+/// ω0 = sqrt(g/l), β = b/(m ω0), M = μ r_b/l.
+#[test]
+fn regression_issue_7_free_segments_fitted_as_free_decays() {
+    let dir = tempfile::tempdir().unwrap();
+    let camp = dir.path().join("campaign");
+    let (b, mu) = (0.5, 0.15);
+    make_campaign(&camp, &campaign_toml(71, 0.0, b, mu));
+    let out = dir.path().join("out");
+    let s = run(&IdentifyJob {
+        input: camp,
+        out: out.clone(),
+        pipeline: None,
+        overrides: FitOverrides {
+            generations: Some(150),
+            ..FitOverrides::default()
+        },
+        progress: false,
+        free_segments: true,
+    })
+    .unwrap();
+    eprintln!("{s}");
+    let p = out.join("free_segments").join("params.parquet");
+    let (m, l, r_b, g): (f64, f64, f64, f64) = (1.46, 0.265, 0.01225, 9.81);
+    let w0 = (g / l).sqrt();
+    let omega0 = column_f64(&p, "omega0_rad_s")[0];
+    let beta = column_f64(&p, "beta")[0];
+    let m_dry = column_f64(&p, "M")[0];
+    assert!((omega0 / w0 - 1.0).abs() < 0.01, "ω0 {omega0} vs {w0}");
+    let beta_true = b / (m * w0);
+    let m_true = mu * r_b / l;
+    assert!(
+        (beta / beta_true - 1.0).abs() < 0.1,
+        "β {beta} vs {beta_true}"
+    );
+    assert!((m_dry / m_true - 1.0).abs() < 0.1, "M {m_dry} vs {m_true}");
+    let ids = column_str(&out.join("free_segments").join("runs.parquet"), "run_id");
+    assert!(ids.iter().all(|id| id.ends_with("-free")), "{ids:?}");
 }

@@ -95,6 +95,10 @@ struct IdentifyArgs {
     /// Evaluate every trial in full (the plain algorithm; same result, slower).
     #[arg(long)]
     no_early_abandon: bool,
+    /// Also fit the free-motion segments before the shakers start as free decays
+    /// (into OUT/free_segments/).
+    #[arg(long)]
+    free_segments: bool,
     /// No progress bar.
     #[arg(long)]
     quiet: bool,
@@ -277,6 +281,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                     no_early_abandon: a.no_early_abandon,
                 },
                 progress: !a.quiet,
+                free_segments: a.free_segments,
             })?;
             print!("{s}");
         }

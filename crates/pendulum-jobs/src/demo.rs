@@ -109,6 +109,7 @@ pub fn campaign(
             ..Default::default()
         },
         progress,
+        free_segments: false,
     })?;
     Ok(DemoCampaign {
         campaign_dir,

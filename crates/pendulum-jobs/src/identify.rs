@@ -41,6 +41,45 @@ pub struct IdentifyJob {
     pub pipeline: Option<PathBuf>,
     pub overrides: FitOverrides,
     pub progress: bool,
+    /// Also fit the free-motion segments before the shakers start, as free decays (excitation
+    /// off, identifiable terms), into `OUT/free_segments/`.
+    pub free_segments: bool,
+}
+
+/// Shortest free-motion segment fitted as a free decay, s (about three swings of the study's
+/// pendulum: the fit's restart segments span two).
+pub const FREE_SEGMENT_MIN_S: f64 = 2.5;
+
+/// The free-motion segment before each run's shaker start, as a run of its own with no shaker
+/// (`<id>-free`, same role): it goes through the same stages as a free-decay recording.
+pub fn free_segment_runs(ctx: &Context) -> Vec<RunData> {
+    let mut out = Vec::new();
+    for run in &ctx.runs {
+        let Some(al) = ctx.alignments.get(&run.id).filter(|a| !a.is_free()) else {
+            continue;
+        };
+        let (t0, t1) = al.free_segment_s;
+        if !(t1 - t0 >= FREE_SEGMENT_MIN_S) {
+            continue;
+        }
+        let (lo, hi) = (
+            run.enc_t_s.partition_point(|&t| t < t0),
+            run.enc_t_s.partition_point(|&t| t <= t1),
+        );
+        let mut rig = run.rig.clone();
+        rig.omega_hz = None;
+        out.push(RunData {
+            id: format!("{}-free", run.id),
+            role: run.role,
+            rig,
+            enc_t_s: run.enc_t_s[lo..hi].to_vec(),
+            theta_rad: run.theta_rad[lo..hi].to_vec(),
+            acc_t_s: Vec::new(),
+            az_m_s2: Vec::new(),
+            ax_m_s2: Vec::new(),
+        });
+    }
+    out
 }
 
 /// Loads a pipeline file or the built-in one.
@@ -182,13 +221,38 @@ pub fn run(job: &IdentifyJob) -> Result<OutputSummary, JobError> {
         b.finish_and_clear();
     }
     res?;
-    write_outputs(
+    let mut summary = write_outputs(
         &ctx,
         &job.out,
         &pipeline_text,
         "pendulum identify",
         started.elapsed().as_secs_f64(),
-    )
+    )?;
+    if job.free_segments {
+        let free = free_segment_runs(&ctx);
+        if !free.iter().any(|r| r.role == Role::Identify) {
+            summary.text += &format!(
+                "\nfree segments: none of at least {FREE_SEGMENT_MIN_S} s before a shaker start in an identify run; not fitted\n"
+            );
+            return Ok(summary);
+        }
+        let n = free.len();
+        let mut fctx = Context::new(free);
+        pipeline.run(&mut fctx)?;
+        let fs = write_outputs(
+            &fctx,
+            &job.out.join("free_segments"),
+            &pipeline_text,
+            "pendulum identify --free-segments",
+            started.elapsed().as_secs_f64(),
+        )?;
+        summary.text += &format!(
+            "\nfree segments before the shaker starts ({n} runs), fitted as free decays:\n{fs}"
+        );
+        summary.tables.extend(fs.tables);
+        summary.plots.extend(fs.plots);
+    }
+    Ok(summary)
 }
 
 /// What to validate: fixed parameters from a params.parquet.

@@ -65,7 +65,29 @@ pub fn prepare_run(
     };
     let (t, th) = (&run.enc_t_s, &run.theta_rad);
     let lo = t.partition_point(|&x| x < al.t0_s);
-    let hi = t.partition_point(|&x| x <= al.t0_s + window.window_s);
+    let t_end = t[t.len() - 1];
+    let mut tail_t = Vec::new();
+    // The simulated steady state is classified over the same span as the measured one (the
+    // capture's last `tail_s`), or, with `t_sim_s`, over the second half of t_sim after the window.
+    let (from, to) = match window.t_sim_s {
+        Some(ts) => (
+            al.t0_s + window.window_s + 0.5 * ts,
+            al.t0_s + window.window_s + ts,
+        ),
+        None if al.is_free() => (
+            crate::measured::free_tail_start_s(t_end, al.t0_s, steady_cfg),
+            t_end,
+        ),
+        None => (t_end - steady_cfg.tail_s, t_end),
+    };
+    // A free decay shorter than window + tail (the free segment before a shaker starts) ends
+    // its window where its tail starts, so that the tail is simulated beyond the window.
+    let window_end = if al.is_free() && window.t_sim_s.is_none() {
+        (al.t0_s + window.window_s).min(from)
+    } else {
+        al.t0_s + window.window_s
+    };
+    let hi = t.partition_point(|&x| x <= window_end);
     if hi <= lo + 10 {
         return Err(ProcessError::Run {
             run: run.id.clone(),
@@ -82,21 +104,6 @@ pub fn prepare_run(
         std::f64::consts::TAU / w0
     } else {
         1.0 / al.omega_hz
-    };
-    let t_end = t[t.len() - 1];
-    let mut tail_t = Vec::new();
-    // The simulated steady state is classified over the same span as the measured one (the
-    // capture's last `tail_s`), or, with `t_sim_s`, over the second half of t_sim after the window.
-    let (from, to) = match window.t_sim_s {
-        Some(ts) => (
-            al.t0_s + window.window_s + 0.5 * ts,
-            al.t0_s + window.window_s + ts,
-        ),
-        None if al.is_free() => (
-            crate::measured::free_tail_start_s(t_end, al.t0_s, steady_cfg),
-            t_end,
-        ),
-        None => (t_end - steady_cfg.tail_s, t_end),
     };
     // A free decay has no Poincaré section: its tail is sampled 16 times per small swing.
     let step_s = if al.is_free() {
