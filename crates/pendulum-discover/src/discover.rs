@@ -427,16 +427,7 @@ fn speed_drift_row(
     if !row.accepted {
         return Ok((row, None));
     }
-    let objective = StudyObjective {
-        runs: &id2,
-        spec: &spec,
-        kappa: 2.0,
-        sim: pendulum_model::SimOptions::with_tol(1e-6),
-        ic_halfwidth: 0.1,
-        fixed_params: None,
-        penalty: true,
-        order: Default::default(),
-    };
+    let objective = refit_objective(&id2, &spec);
     let mut full = x.clone();
     full.extend_from_slice(&ics2);
     let eval = objective.evaluate(&full);
@@ -546,6 +537,20 @@ impl Problem for ParamsOnly<'_> {
     }
 }
 
+/// The objective every confirming refit and its evaluation use (κ = 2, tolerance 1e-6).
+fn refit_objective<'a>(runs: &'a [PreparedRun], spec: &'a ModelSpec) -> StudyObjective<'a> {
+    StudyObjective {
+        runs,
+        spec,
+        kappa: 2.0,
+        sim: pendulum_model::SimOptions::with_tol(1e-6),
+        ic_halfwidth: 0.1,
+        fixed_params: None,
+        penalty: true,
+        order: Default::default(),
+    }
+}
+
 fn refit(
     runs: &[PreparedRun],
     spec: &ModelSpec,
@@ -554,16 +559,7 @@ fn refit(
     evals: usize,
 ) -> (Vec<f64>, f64) {
     let problem = ParamsOnly {
-        inner: StudyObjective {
-            runs,
-            spec,
-            kappa: 2.0,
-            sim: pendulum_model::SimOptions::with_tol(1e-6),
-            ic_halfwidth: 0.1,
-            fixed_params: None,
-            penalty: true,
-            order: Default::default(),
-        },
+        inner: refit_objective(runs, spec),
         ics: ics.to_vec(),
     };
     let bounds = problem.bounds();
@@ -901,16 +897,7 @@ pub fn discover(
         };
         confirmed.push((c.effect.clone(), row.clone()));
         if accepted {
-            let ev = StudyObjective {
-                runs: &id_runs,
-                spec: &spec,
-                kappa: 2.0,
-                sim: pendulum_model::SimOptions::with_tol(1e-6),
-                ic_halfwidth: 0.1,
-                fixed_params: None,
-                penalty: true,
-                order: Default::default(),
-            };
+            let ev = refit_objective(&id_runs, &spec);
             let mut full = x.clone();
             full.extend_from_slice(&ics);
             let eval = ev.evaluate(&full);

@@ -575,6 +575,33 @@ impl WorkOrder {
     }
 }
 
+/// θ simulated from (`t_from`, `y_from`) at each of `times` (ascending); `None` when there are
+/// none or the integration fails.
+fn theta_at(
+    model: &Model,
+    opts: &SimOptions,
+    t_from: f64,
+    y_from: [f64; 2],
+    times: &[f64],
+) -> Option<Vec<f64>> {
+    let t_end = *times.last()?;
+    let mut th = Vec::with_capacity(times.len());
+    integrate(
+        model,
+        opts,
+        t_from,
+        y_from,
+        t_end,
+        times.iter().copied(),
+        |s| {
+            th.push(s.theta);
+            ControlFlow::Continue(())
+        },
+    )
+    .ok()?;
+    Some(th)
+}
+
 /// The simulated steady state over the run's tail, classified like the measurement
 /// (θ at each Poincaré time and a quarter period later; a free decay's θ at its tail's sample
 /// times, rest or not). `t_from` and `y_from` are in the model's time unit, `k` as in
@@ -594,21 +621,7 @@ pub fn simulated_steady(
             .map(|t| t * k)
             .filter(|&t| t >= t_from)
             .collect();
-        let t_end = *times.last()?;
-        let mut th = Vec::with_capacity(times.len());
-        integrate(
-            model,
-            opts,
-            t_from,
-            y_from,
-            t_end,
-            times.iter().copied(),
-            |s| {
-                th.push(s.theta);
-                ControlFlow::Continue(())
-            },
-        )
-        .ok()?;
+        let th = theta_at(model, opts, t_from, y_from, &times)?;
         return Some(crate::measured::classify_free(&th, run.classify.rest_tol));
     }
     let q = 0.25 * run.period();
@@ -622,21 +635,7 @@ pub fn simulated_steady(
     if times.len() < 4 {
         return None;
     }
-    let t_end = *times.last()?;
-    let mut th = Vec::with_capacity(times.len());
-    integrate(
-        model,
-        opts,
-        t_from,
-        y_from,
-        t_end,
-        times.iter().copied(),
-        |s| {
-            th.push(s.theta);
-            ControlFlow::Continue(())
-        },
-    )
-    .ok()?;
+    let th = theta_at(model, opts, t_from, y_from, &times)?;
     let a: Vec<f64> = th.iter().step_by(2).copied().collect();
     let b: Vec<f64> = th
         .chunks(2)
