@@ -349,6 +349,8 @@ fn realigned(ctx: &Context, ev: &DriftEvidence) -> Result<Context, ProcessError>
             al2.t0_s = f.t0_s;
             al2.omega_hz = f.omega_hz;
             al2.speed_drift_hz_per_s = f.drift_hz_per_s;
+            // A constant-speed fit of a drifting crank biases its amplitude too.
+            al2.accel_gain = f.accel_gain;
             ic2 = pendulum_process::ic::estimate_state(run, f.t0_s, &Default::default())?;
         }
         ctx2.alignments.insert(run.id.clone(), al2);
@@ -1013,7 +1015,7 @@ pub fn discover(
             note: w.clone(),
         });
     }
-    if let Some(row) = accel_gain_row(ctx, cfg) {
+    if let Some(row) = accel_gain_row(ctx_drift.as_ref().unwrap_or(ctx), cfg) {
         // Before `unexplained`, which stays last.
         let at = rows
             .iter()

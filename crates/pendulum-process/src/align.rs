@@ -421,6 +421,8 @@ pub struct DriftFit {
     pub t0_s: f64,
     /// Crank speed at that peak, Hz.
     pub omega_hz: f64,
+    /// Amplitude over the nominal crank-rod acceleration (as [`Alignment::accel_gain`]), –.
+    pub accel_gain: f64,
     /// dΩ/dτ, Hz/s, and its standard uncertainty.
     pub drift_hz_per_s: f64,
     pub drift_sigma_hz_per_s: f64,
@@ -507,6 +509,7 @@ pub fn fit_speed_drift(run: &RunData, al: &Alignment) -> Option<DriftFit> {
     (converged && p[1] > 0.0 && p[2] > 0.0).then_some(DriftFit {
         t0_s: al.t0_s + p[4],
         omega_hz: p[2],
+        accel_gain: p[1],
         drift_hz_per_s: p[3],
         drift_sigma_hz_per_s: cov[3 * 5 + 3].max(0.0).sqrt(),
         residual_rms_m_s2: rms,
