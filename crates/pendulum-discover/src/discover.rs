@@ -208,6 +208,19 @@ fn t95(df: usize) -> f64 {
     }
 }
 
+/// A quantity measured once per run (n ≥ 2): its mean, the half-width of the mean's 95 %
+/// interval from the runs' scatter (Student's t), and ΔBIC of "mean" against `nominal`.
+fn per_run_mean(values: &[f64], nominal: f64) -> (f64, f64, f64) {
+    let n = values.len();
+    let nf = n as f64;
+    let mean = values.iter().sum::<f64>() / nf;
+    let rss1 = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>();
+    let rss0 = values.iter().map(|v| (v - nominal).powi(2)).sum::<f64>();
+    let half = t95(n.saturating_sub(1)) * (rss1 / (nf - 1.0) / nf).sqrt();
+    let delta_bic = nf * (rss1.max(1e-300) / rss0.max(1e-300)).ln() + nf.ln();
+    (mean, half, delta_bic)
+}
+
 /// `accel_gain` is a sensor effect: the model is driven by the crank's geometry, so it cannot
 /// change E_θ; it shows in the amplitude the alignment's crank-rod fit needs (G = 1 + k_a).
 /// Estimate k_a from the identify runs' G (interval from their scatter, Student's t), and score
@@ -230,14 +243,8 @@ fn accel_gain_row(ctx: &Context, cfg: &DiscoverConfig) -> Option<DiagnosisRow> {
     if n < 3 {
         return None;
     }
-    let nf = n as f64;
-    let mean = g_id.iter().sum::<f64>() / nf;
+    let (mean, half, delta_bic) = per_run_mean(&g_id, 1.0);
     let est = mean - 1.0;
-    let rss1 = g_id.iter().map(|g| (g - mean).powi(2)).sum::<f64>();
-    let rss0 = g_id.iter().map(|g| (g - 1.0).powi(2)).sum::<f64>();
-    let se = (rss1 / (nf - 1.0) / nf).sqrt();
-    let half = t95(n - 1) * se;
-    let delta_bic = nf * (rss1.max(1e-300) / rss0.max(1e-300)).ln() + nf.ln();
     let before = g_val.iter().map(|g| (g - 1.0).powi(2)).sum::<f64>();
     let after = g_val.iter().map(|g| (g - 1.0 - est).powi(2)).sum::<f64>();
     let gain = if g_val.is_empty() {
@@ -315,12 +322,7 @@ fn drift_evidence(ctx: &Context, cfg: &DiscoverConfig) -> Option<DriftEvidence> 
     if n < 3 {
         return None;
     }
-    let nf = n as f64;
-    let est = d_id.iter().sum::<f64>() / nf;
-    let rss1 = d_id.iter().map(|d| (d - est).powi(2)).sum::<f64>();
-    let rss0 = d_id.iter().map(|d| d * d).sum::<f64>();
-    let half = t95(n - 1) * (rss1 / (nf - 1.0) / nf).sqrt();
-    let delta_bic = nf * (rss1.max(1e-300) / rss0.max(1e-300)).ln() + nf.ln();
+    let (est, half, delta_bic) = per_run_mean(&d_id, 0.0);
     let excludes_zero = est - half > 0.0 || est + half < 0.0;
     Some(DriftEvidence {
         fits,
