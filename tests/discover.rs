@@ -112,7 +112,6 @@ fn regression_issue_5_linear_base_finds_quadratic_drag() {
 }
 
 #[test]
-#[ignore = "known failure (issue 5 note): named, but the equation-error T_c is 0.0079 vs 0.0126 N·m (−37 %, interval 0.0041–0.0117); this campaign barely separates T_c from μ"]
 fn regression_issue_5_finds_constant_dry_torque() {
     let tc = rng(3).random_range(0.006..0.015);
     let s = discover(

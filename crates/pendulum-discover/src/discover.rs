@@ -692,6 +692,16 @@ pub fn discover(
             weak_runs.push((run.id.clone(), run.role));
         }
     }
+    // The encoder's per-run zeroing errors are nuisance terms of every model.
+    let id_idx: Vec<usize> = (0..weak_runs.len())
+        .filter(|&i| weak_runs[i].1 == Role::Identify && weak.iter().any(|r| r.run == i))
+        .collect();
+    let zero_cols = crate::weak::add_zero_error_contrasts(&mut weak, &id_idx);
+    let base_cols: Vec<usize> = base
+        .columns()
+        .into_iter()
+        .chain(zero_cols.clone())
+        .collect();
     // Weights from the residual variance of the whole catalogue's fit (so that a missing effect's
     // own torque does not count as noise and down-weight where it lives).
     {
@@ -700,8 +710,8 @@ pub fn discover(
             .filter(|r| weak_runs[r.run].1 == Role::Identify)
             .cloned()
             .collect();
-        let all: Vec<usize> = (0..=crate::weak::DELAY).collect();
-        if let Some(full) = ols(&id_rows, &all).or_else(|| ols(&id_rows, &base.columns())) {
+        let all: Vec<usize> = (0..=crate::weak::DELAY).chain(zero_cols.clone()).collect();
+        if let Some(full) = ols(&id_rows, &all).or_else(|| ols(&id_rows, &base_cols)) {
             let res = full.residuals(&weak);
             crate::weak::set_weights(&mut weak, &res);
         }
@@ -724,7 +734,7 @@ pub fn discover(
             .map(|(e, r)| r.weight * e * e)
             .sum()
     };
-    let base_ols = ols(&id_rows, &base.columns()).ok_or_else(|| ProcessError::Run {
+    let base_ols = ols(&id_rows, &base_cols).ok_or_else(|| ProcessError::Run {
         run: "(identify runs)".into(),
         reason: format!(
             "too few usable equation-error windows ({}) for the screen",
@@ -734,7 +744,13 @@ pub fn discover(
     let residual_base = base_ols.residuals(&weak);
 
     // Screen.
-    let screened = stepwise(&id_rows, base, cfg.screen_threshold, cfg.max_effects);
+    let screened = stepwise(
+        &id_rows,
+        base,
+        &zero_cols,
+        cfg.screen_threshold,
+        cfg.max_effects,
+    );
     let (chosen, first_round) = (&screened.chosen, &screened.first_round);
 
     // Held-out noise: the base model's validation with two seeds.
@@ -773,7 +789,7 @@ pub fn discover(
             ics = m.ics;
         }
     }
-    let mut current_cols = base.columns();
+    let mut current_cols = base_cols.clone();
     current_cols.extend(screened.nuisance.iter().copied());
     let mut baseline: Option<Vec<RunFit>> = None;
     let mut rows: Vec<DiagnosisRow> = Vec::new();

@@ -9,7 +9,7 @@
 use pendulum_process::linalg::{inverse, solve};
 use serde::{Deserialize, Serialize};
 
-use crate::weak::{WeakRow, DELAY};
+use crate::weak::{WeakRow, DELAY, OFFSET};
 
 /// The base models discover starts from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -92,7 +92,7 @@ pub fn candidates(base: Base) -> Vec<Candidate> {
     }
     out.push(cand("horizontal_base", vec![13]));
     out.push(cand("extra_inertia", vec![14]));
-    out.push(cand("encoder_offset", vec![15]));
+    out.push(cand("encoder_offset", vec![OFFSET]));
     out.push(cand("accel_delay", vec![DELAY]));
     out
 }
@@ -247,7 +247,7 @@ pub const ENCODER_OFFSET_FLOOR_RAD: f64 = 4.0 * 2.0 * std::f64::consts::PI / 409
 pub fn is_nuisance(s: &Screened) -> bool {
     s.candidate.effect == "encoder_offset"
         && s.fit
-            .coef_of(15)
+            .coef_of(OFFSET)
             .is_some_and(|(v, _)| v.abs() <= ENCODER_OFFSET_FLOOR_RAD)
 }
 
@@ -263,10 +263,18 @@ pub struct Stepwise {
 }
 
 /// Forward stepwise selection: the sequence of candidates that each lower BIC by more than
-/// `threshold` given the ones before (at most `max_effects`). A best candidate that is only a
-/// normal rig tolerance ([`is_nuisance`]) is absorbed as a nuisance term without using a round.
-pub fn stepwise(rows: &[WeakRow], base: Base, threshold: f64, max_effects: usize) -> Stepwise {
+/// `threshold` given the ones before (at most `max_effects`), on top of the base's columns and
+/// `extra` nuisance columns. A best candidate that is only a normal rig tolerance
+/// ([`is_nuisance`]) is absorbed as a nuisance term without using a round.
+pub fn stepwise(
+    rows: &[WeakRow],
+    base: Base,
+    extra: &[usize],
+    threshold: f64,
+    max_effects: usize,
+) -> Stepwise {
     let mut current = base.columns();
+    current.extend_from_slice(extra);
     let mut chosen: Vec<Screened> = Vec::new();
     let mut first_round = Vec::new();
     let mut nuisance = Vec::new();

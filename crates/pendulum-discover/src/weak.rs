@@ -35,6 +35,9 @@ pub const TERMS: [&str; 16] = [
     "offset",  // (1 + A_y) cos θ
 ];
 
+/// Index of the encoder-offset regressor (1 + A_y) cos θ in [`WeakRow::x`].
+pub const OFFSET: usize = 15;
+
 /// Index of the accel-delay regressor in [`WeakRow::x`] (after [`TERMS`]).
 pub const DELAY: usize = TERMS.len();
 
@@ -110,6 +113,33 @@ pub fn set_weights(rows: &mut [WeakRow], residuals: &[f64]) {
     }
 }
 
+/// Adds one column per identify run but the last for the encoder's per-run zeroing error: the
+/// count is zeroed at every power-on to within a few counts (rig.md), and an offset θ_r adds
+/// θ_r (1 + A_y) cos θ to run r's torque. A 2-count zero error is 3e-3 m g l, as large as a
+/// plausible constant dry torque, and of a different sign in each run: one global offset column
+/// cannot absorb it, and what is left was mistaken for (or hid) other terms. The columns are
+/// sum-to-zero contrasts (run k minus the last identify run), so the global offset column
+/// (`offset`) still estimates the offset common to all runs, the effect `encoder_offset`.
+/// Returns the new column indices (empty with fewer than two identify runs). Validate rows get
+/// zeros: their own zero errors are not fitted.
+pub fn add_zero_error_contrasts(rows: &mut [WeakRow], identify_runs: &[usize]) -> Vec<usize> {
+    let width = rows.iter().map(|r| r.x.len()).max().unwrap_or(0);
+    let k = identify_runs.len().saturating_sub(1);
+    let last = identify_runs.last().copied();
+    for r in rows.iter_mut() {
+        r.x.resize(width, 0.0);
+        let off = r.x[OFFSET];
+        let mut extra = vec![0.0; k];
+        if let Some(j) = identify_runs[..k].iter().position(|&q| q == r.run) {
+            extra[j] = off;
+        } else if Some(r.run) == last {
+            extra.iter_mut().for_each(|v| *v = -off);
+        }
+        r.x.extend(extra);
+    }
+    (width..width + k).collect()
+}
+
 /// Weak-form settings.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -132,7 +162,7 @@ pub struct WeakConfig {
 impl Default for WeakConfig {
     fn default() -> Self {
         Self {
-            half_width_s: 0.08,
+            half_width_s: 0.16,
             deriv_half_width_s: 0.02,
             forced_s: 60.0,
             stuck_theta_dot: 0.02,
