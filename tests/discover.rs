@@ -62,6 +62,14 @@ fn assert_found(s: &DiscoverSummary, effect: &str, truth: f64, rel: f64, abs: f6
         .find(|r| r.effect == effect)
         .unwrap();
     let err = (row.estimate - truth).abs();
+    eprintln!(
+        "found {effect}: estimate {:.4e} vs truth {truth:.4e} ({:+.1} %), interval [{:.4e}, {:.4e}], held-out gain {:.1} %",
+        row.estimate,
+        100.0 * (row.estimate / truth - 1.0),
+        row.ci_low,
+        row.ci_high,
+        100.0 * row.heldout_gain
+    );
     assert!(
         err <= rel * truth.abs() || err <= abs,
         "{effect}: estimate {} vs truth {truth}",

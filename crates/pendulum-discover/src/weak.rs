@@ -442,14 +442,76 @@ mod tests {
             fit_window_s: (0.0, 0.0),
             speed_drift_hz_per_s: 0.0,
         };
-        let rows = weak_rows(0, &run, &al, &WeakConfig::default());
-        assert!(rows.len() > 50, "{} rows", rows.len());
-        let fit = crate::screen::ols(&rows, &[0, 2, 14]).unwrap();
-        let (b, _) = fit.coef_of(0).unwrap();
-        let (mm, _) = fit.coef_of(2).unwrap();
-        let (j, _) = fit.coef_of(14).unwrap();
-        assert!((b - 0.05).abs() < 0.002, "beta {b}");
-        assert!((mm - 0.007).abs() < 0.0005, "M {mm}");
-        assert!(j.abs() < 0.01, "j {j}");
+        // The old default half-width and the current one.
+        for hw in [0.08, 0.16] {
+            let cfg = WeakConfig {
+                half_width_s: hw,
+                ..WeakConfig::default()
+            };
+            let rows = weak_rows(0, &run, &al, &cfg);
+            assert!(rows.len() > 30, "h = {hw}: {} rows", rows.len());
+            let fit = crate::screen::ols(&rows, &[0, 2, 14]).unwrap();
+            let (b, _) = fit.coef_of(0).unwrap();
+            let (mm, _) = fit.coef_of(2).unwrap();
+            let (j, _) = fit.coef_of(14).unwrap();
+            assert!((b - 0.05).abs() < 0.002, "h = {hw}: beta {b}");
+            assert!((mm - 0.007).abs() < 0.0005, "h = {hw}: M {mm}");
+            assert!(j.abs() < 0.01, "h = {hw}: j {j}");
+        }
+    }
+}
+
+#[cfg(test)]
+mod contrast_tests {
+    use super::*;
+
+    fn row(run: usize, x_offset: f64, target: f64) -> WeakRow {
+        let mut x = vec![0.0; DELAY + 1];
+        x[OFFSET] = x_offset;
+        WeakRow {
+            run,
+            tau_s: 0.0,
+            theta: 0.0,
+            theta_dot_rad_s: 0.0,
+            phase: 0.0,
+            a_y_meas: 0.0,
+            a_x_meas: 0.0,
+            target,
+            x,
+            weight: 1.0,
+        }
+    }
+
+    /// With per-run offsets θ_r, the offset column estimates their plain mean and each run's own
+    /// offset is the mean plus its contrast; validate rows (run 3) get zero contrasts.
+    #[test]
+    fn zero_error_contrasts_split_common_and_per_run_offsets() {
+        let offsets = [0.003, -0.002, 0.0015];
+        let mut rows = Vec::new();
+        for (r, th) in offsets.iter().enumerate() {
+            for i in 0..40 {
+                let x = ((i * 7 + r * 3) as f64 * 0.37).cos() + 0.2;
+                rows.push(row(r, x, th * x));
+            }
+        }
+        rows.push(row(3, 1.0, 0.5));
+        let cols = add_zero_error_contrasts(&mut rows, &[0, 1, 2]);
+        assert_eq!(cols, vec![DELAY + 1, DELAY + 2]);
+        assert!(rows.last().unwrap().x[DELAY + 1..]
+            .iter()
+            .all(|v| *v == 0.0));
+        let mut all = vec![OFFSET];
+        all.extend(&cols);
+        let fit = crate::screen::ols(&rows[..120], &all).unwrap();
+        let mean = offsets.iter().sum::<f64>() / 3.0;
+        let (m, _) = fit.coef_of(OFFSET).unwrap();
+        assert!((m - mean).abs() < 1e-12, "{m} vs {mean}");
+        for (k, th) in offsets[..2].iter().enumerate() {
+            let (d, _) = fit.coef_of(cols[k]).unwrap();
+            assert!((m + d - th).abs() < 1e-12);
+        }
+        // The last run's offset is the mean minus the other contrasts.
+        let d_sum: f64 = cols.iter().map(|&c| fit.coef_of(c).unwrap().0).sum();
+        assert!((m - d_sum - offsets[2]).abs() < 1e-12);
     }
 }

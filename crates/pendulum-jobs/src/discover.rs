@@ -80,13 +80,20 @@ pub fn diagnosis_table(d: &Discovery) -> String {
     let mut t = String::new();
     let _ = writeln!(
         t,
-        "{:<24} {:>8} {:>12} {:>24} {:<6} {:>9} {:>9}",
-        "effect", "accepted", "estimate", "95 % interval", "unit", "ΔBIC", "gain"
+        "{:<24} {:>8} {:>12} {:>24} {:<6} {:>9} {:>16} {:>8}",
+        "effect",
+        "accepted",
+        "estimate",
+        "95 % interval",
+        "unit",
+        "ΔBIC",
+        "E_θ gain ± noise",
+        "eq gain"
     );
     for r in &d.rows {
         let _ = writeln!(
             t,
-            "{:<24} {:>8} {:>12.4e} [{:>10.3e}, {:>10.3e}] {:<6} {:>9.1} {:>8.1}%",
+            "{:<24} {:>8} {:>12.4e} [{:>10.3e}, {:>10.3e}] {:<6} {:>9.1} {:>7.1}% ±{:>5.1}% {:>7.1}%",
             r.effect,
             if r.accepted { "YES" } else { "no" },
             r.estimate,
@@ -94,7 +101,9 @@ pub fn diagnosis_table(d: &Discovery) -> String {
             r.ci_high,
             r.unit,
             r.delta_bic,
-            100.0 * r.heldout_gain
+            100.0 * r.heldout_gain,
+            100.0 * r.heldout_noise,
+            100.0 * r.heldout_eq_gain
         );
     }
     t
@@ -215,6 +224,16 @@ pub fn run(job: &DiscoverJob) -> Result<DiscoverSummary, JobError> {
             f(
                 rows.iter().map(|r| r.heldout_gain).collect(),
                 "heldout_gain",
+                "1 (fraction)",
+            ),
+            f(
+                rows.iter().map(|r| r.heldout_noise).collect(),
+                "heldout_noise",
+                "1 (fraction; 1.96 × the standard error of heldout_gain)",
+            ),
+            f(
+                rows.iter().map(|r| r.heldout_eq_gain).collect(),
+                "heldout_eq_gain",
                 "1 (fraction)",
             ),
             f(

@@ -754,6 +754,9 @@ pub struct Evaluation {
     pub f_obj: f64,
     pub e_theta: f64,
     pub per_run_e: Vec<f64>,
+    /// Per run, E_θ of each multiple-shooting segment in time order (one entry without
+    /// segments; empty for a failed run): the units a paired held-out comparison resamples.
+    pub per_run_segment_e: Vec<Vec<f64>>,
     pub per_run_sim_steady: Vec<Option<SteadyState>>,
 }
 
@@ -909,6 +912,12 @@ impl StudyObjective<'_> {
             }
         }
         let es = self.per_run(&segs, &seg_e);
+        let mut per_run_segment_e = vec![Vec::new(); self.runs.len()];
+        for (g, e) in segs.iter().zip(&seg_e) {
+            if !failed[g.run] {
+                per_run_segment_e[g.run].push(*e);
+            }
+        }
         let mut per_run_e = Vec::new();
         let mut steadies = Vec::new();
         let mut f = 0.0;
@@ -935,6 +944,7 @@ impl StudyObjective<'_> {
             f_obj: f,
             e_theta: per_run_e.iter().sum(),
             per_run_e,
+            per_run_segment_e,
             per_run_sim_steady: steadies,
         }
     }

@@ -272,6 +272,9 @@ pub struct RunFit {
     pub ic_est: [f64; 2],
     pub ic_fit: [f64; 2],
     pub e_theta: f64,
+    /// E_θ of each multiple-shooting segment in time order (see `Evaluation`).
+    #[serde(default)]
+    pub segment_e: Vec<f64>,
     pub measured: SteadyState,
     pub simulated: Option<SteadyState>,
 }
@@ -397,6 +400,7 @@ pub fn identify(
             ic_est: r.ic_est,
             ic_fit: [best_x[n + 2 * j], best_x[n + 2 * j + 1]],
             e_theta: eval.per_run_e[j],
+            segment_e: eval.per_run_segment_e[j].clone(),
             measured: r.steady,
             simulated: eval.per_run_sim_steady[j],
         })
@@ -538,6 +542,7 @@ pub fn validate(
                 ic_est: run.ic_est,
                 ic_fit: [res.best_x[0], res.best_x[1]],
                 e_theta: eval.per_run_e[0],
+                segment_e: eval.per_run_segment_e[0].clone(),
                 measured: run.steady,
                 simulated: eval.per_run_sim_steady[0],
             })
