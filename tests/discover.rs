@@ -313,11 +313,15 @@ fn regression_issue_5_finds_speed_drift() {
 /// Survey (slow, by hand with `--ignored`): campaigns with nothing hidden, drawn damping and
 /// seeds; prints what (if anything) each names. The false-alarm rate in the issue 5 note.
 #[test]
-#[ignore = "survey for the issue 5 note: eight campaigns, about 3 minutes"]
+#[ignore = "survey for the issue 5 note: SURVEY_N campaigns (default 8), ~20 s each"]
 fn survey_issue_5_false_alarm_rate() {
+    let n: u64 = std::env::var("SURVEY_N")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(8);
     let mut r = rng(40);
-    let mut alarms = 0;
-    for k in 0..8u64 {
+    let (mut alarms, mut unexplained) = (0, 0);
+    for k in 0..n {
         let b = r.random_range(0.3..0.7);
         let mu = r.random_range(0.08..0.2);
         let s = discover(300 + k, Base::Reference, 0.0, b, mu, "");
@@ -329,10 +333,17 @@ fn survey_issue_5_false_alarm_rate() {
             .map(|r| r.effect.as_str())
             .collect();
         alarms += usize::from(!accepted.is_empty());
-        eprintln!("survey k={k} b={b:.3} mu={mu:.3} accepted={accepted:?}");
+        unexplained += usize::from(s.discovery.unexplained.is_some());
+        eprintln!(
+            "survey k={k} b={b:.3} mu={mu:.3} accepted={accepted:?} unexplained={:?}",
+            s.discovery.unexplained
+        );
     }
-    eprintln!("survey: false alarms in {alarms} of 8");
-    assert!(alarms <= 1, "false alarms in {alarms} of 8");
+    eprintln!("survey: false alarms in {alarms} of {n}; `unexplained` in {unexplained} of {n}");
+    assert!(
+        alarms as f64 <= (n as f64 / 8.0).ceil(),
+        "false alarms in {alarms} of {n}"
+    );
 }
 
 /// `viscous_linear` is a reference-model term: it is found where the model in hand lacks it,
@@ -380,4 +391,181 @@ fn regression_issue_5_finds_a_pair() {
             row.estimate
         );
     }
+}
+
+/// A drawn size of one hidden effect: (truth in the diagnosis's unit, the twin's effects table
+/// line, base, a, b, μ). Ranges as in the regression tests above.
+fn draw(effect: &str, r: &mut rand_chacha::ChaCha8Rng) -> (f64, String, Base, f64, f64, f64) {
+    let sign = |r: &mut rand_chacha::ChaCha8Rng| if r.random::<bool>() { 1.0 } else { -1.0 };
+    match effect {
+        "coulomb_bearing" => {
+            let mu = r.random_range(0.08..0.2);
+            (mu, String::new(), Base::Linear, 0.0, 0.3, mu)
+        }
+        "viscous_quadratic" => {
+            let a = r.random_range(0.05..0.2);
+            (a, String::new(), Base::Linear, a, 0.3, 0.0)
+        }
+        "viscous_linear" => {
+            let b = r.random_range(0.3..0.7);
+            (b, String::new(), Base::Dry, 0.0, b, 0.15)
+        }
+        "bearing_load_base_accel" => {
+            let mu = r.random_range(0.1..0.2);
+            let s = "bearing_load_base_accel = true".to_string();
+            (mu, s, Base::Reference, 0.0, 0.5, mu)
+        }
+        _ => {
+            let (t, s) = match effect {
+                "coulomb_constant" => {
+                    let v = r.random_range(0.006..0.015);
+                    (v, format!("coulomb_constant_t_c_nm = {v}"))
+                }
+                "position_torque" => {
+                    let v = r.random_range(0.015..0.04);
+                    let k = r.random_range(1..=4);
+                    let phi = r.random_range(-3.0..3.0);
+                    (
+                        v,
+                        format!("position_torque = {{ t_p_nm = {v}, k = {k}, phi_p_rad = {phi} }}"),
+                    )
+                }
+                "horizontal_base" => {
+                    let v = r.random_range(0.02..0.08) * sign(r);
+                    (v, format!("horizontal_base_delta_rad = {v}"))
+                }
+                "extra_inertia" => {
+                    let v = r.random_range(0.005..0.02);
+                    (v, format!("extra_inertia_j_kg_m2 = {v}"))
+                }
+                "encoder_offset" => {
+                    let v = r.random_range(0.02..0.08) * sign(r);
+                    (v, format!("encoder_offset_rad = {v}"))
+                }
+                "accel_delay" => {
+                    let v = r.random_range(0.004..0.015);
+                    (v, format!("accel_delay_s = {v}"))
+                }
+                "accel_gain" => {
+                    let v = r.random_range(0.02..0.08) * sign(r);
+                    (v, format!("accel_gain_k_a = {v}"))
+                }
+                "speed_drift" => {
+                    let v = r.random_range(0.0005..0.002) * sign(r);
+                    (v, format!("speed_drift_hz_per_s = {v}"))
+                }
+                other => panic!("no draw for {other}"),
+            };
+            (t, s, Base::Reference, 0.0, 0.5, 0.15)
+        }
+    }
+}
+
+/// Survey (slow, by hand with `--ignored`): every catalogue effect hidden alone
+/// `SURVEY_N` times (default 3) with drawn sizes and fresh seeds, then pairs; prints one line per
+/// campaign (named alone? estimate error; `unexplained`?) and the hit rate. For the issue 5 note.
+#[test]
+#[ignore = "survey for the issue 5 note: 12 effects × SURVEY_N campaigns + pairs, ~10 minutes"]
+fn survey_issue_5_every_effect() {
+    let n: u64 = std::env::var("SURVEY_N")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(3);
+    let effects = [
+        "coulomb_bearing",
+        "viscous_quadratic",
+        "viscous_linear",
+        "bearing_load_base_accel",
+        "coulomb_constant",
+        "position_torque",
+        "horizontal_base",
+        "extra_inertia",
+        "encoder_offset",
+        "accel_delay",
+        "accel_gain",
+        "speed_drift",
+    ];
+    let (mut hits, mut total, mut within) = (0, 0, 0);
+    for (e_idx, effect) in effects.iter().enumerate() {
+        for k in 0..n {
+            let mut r = rng(1000 + 100 * e_idx as u64 + k);
+            let (truth, spec, base, a, b, mu) = draw(effect, &mut r);
+            let s = discover(5000 + 100 * e_idx as u64 + k, base, a, b, mu, &spec);
+            let accepted: Vec<&str> = s
+                .discovery
+                .rows
+                .iter()
+                .filter(|r| r.accepted)
+                .map(|r| r.effect.as_str())
+                .collect();
+            let row = s.discovery.rows.iter().find(|r| r.effect == *effect);
+            let est = row.map_or(f64::NAN, |r| r.estimate);
+            let ok_est = if *effect == "encoder_offset" {
+                (est - truth).abs() <= 0.01
+            } else {
+                (est - truth).abs() <= 0.25 * truth.abs()
+            };
+            let hit = accepted == [*effect];
+            hits += usize::from(hit);
+            within += usize::from(hit && ok_est);
+            total += 1;
+            eprintln!(
+                "survey-every {effect} k={k} truth={truth:.4e} estimate={est:.4e} ({:+.1} %) gain={:.1} % ± {:.1} % eq={:.1} % accepted={accepted:?} unexplained={}",
+                100.0 * (est / truth - 1.0),
+                100.0 * row.map_or(f64::NAN, |r| r.heldout_gain),
+                100.0 * row.map_or(f64::NAN, |r| r.heldout_noise),
+                100.0 * row.map_or(f64::NAN, |r| r.heldout_eq_gain),
+                s.discovery.unexplained.is_some()
+            );
+        }
+    }
+    eprintln!("survey-every: named alone in {hits} of {total}; of those within tolerance {within}");
+    // Pairs: both named, nothing else.
+    let pairs = [
+        ("coulomb_constant", "position_torque"),
+        ("accel_delay", "horizontal_base"),
+        ("encoder_offset", "extra_inertia"),
+        ("coulomb_constant", "horizontal_base"),
+    ];
+    let mut pair_hits = 0;
+    for (p_idx, (e1, e2)) in pairs.iter().enumerate() {
+        let mut r = rng(3000 + p_idx as u64);
+        let (t1, s1, _, _, _, _) = draw(e1, &mut r);
+        let (t2, s2, _, _, _, _) = draw(e2, &mut r);
+        let s = discover(
+            7000 + p_idx as u64,
+            Base::Reference,
+            0.0,
+            0.5,
+            0.15,
+            &format!("{s1}\n{s2}"),
+        );
+        let mut accepted: Vec<&str> = s
+            .discovery
+            .rows
+            .iter()
+            .filter(|r| r.accepted)
+            .map(|r| r.effect.as_str())
+            .collect();
+        accepted.sort_unstable();
+        let mut want = vec![*e1, *e2];
+        want.sort_unstable();
+        pair_hits += usize::from(accepted == want);
+        let est = |e: &str| {
+            s.discovery
+                .rows
+                .iter()
+                .find(|r| r.effect == e)
+                .map_or(f64::NAN, |r| r.estimate)
+        };
+        eprintln!(
+            "survey-pair {e1}+{e2}: truths {t1:.4e}, {t2:.4e}; estimates {:.4e}, {:.4e}; accepted={accepted:?}",
+            est(e1),
+            est(e2)
+        );
+    }
+    eprintln!(
+        "survey-pair: both named (and nothing else) in {pair_hits} of {}",
+        pairs.len()
+    );
 }

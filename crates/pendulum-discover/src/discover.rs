@@ -8,13 +8,20 @@
 //!    trajectory error E_θ (initial states refitted for each model) falls by more than
 //!    max(`gain_min`, the held-out noise), or their equation error (coefficients from the
 //!    identify runs) falls by more than max(`eq_gain_min`, its held-out noise) while E_θ does not
-//!    rise by more than its noise. The noise of a fall is 1.96 × its standard error from the paired differences of its
-//!    units: the 0.5 s multiple-shooting segments of the validate runs for E_θ (each restarts
-//!    from the measured state), the weak-form windows for the equation error. A fall that the
-//!    units' own scatter could produce by chance (one-sided 2.5 %) is not a gain. (Sensor
+//!    rise by more than its noise. The noise of a fall is 1.96 × its standard error from the
+//!    paired differences of its units: the 0.5 s multiple-shooting segments of the validate runs
+//!    for E_θ (each restarts from the measured state), the weak-form windows for the equation
+//!    error. A fall that the units' own scatter could produce by chance (one-sided 2.5 %) is not
+//!    a gain. (Sensor
 //!    effects such as an accelerometer lag move E_θ on 0.5 s segments very little but the
-//!    equation error a lot.) A second effect, added to a model already extended, needs both
-//!    measures.
+//!    equation error a lot.) A second effect, added to a model already extended, is judged the
+//!    same way against that model.
+//!
+//! Effects that enter nonlinearly (an encoder offset, an accelerometer lag) are applied exactly to
+//! the measured motion once accepted (θ − θ_off; the forcing's t = 0 moved by −Δ), their estimate
+//! refined on the corrected view, and the remaining candidates re-screened there, so that the
+//! linearised remainder of a large offset is not named as a second effect (it posed as
+//! `extra_inertia`: θ_off²/2 · sin θ) or left as `unexplained`.
 //!
 //! After the accepted effects are in, the remaining equation error is binned against θ̇, θ and the
 //! forcing phase; a one-way analysis of variance with p < 1e-6 on any of them is reported as
@@ -29,7 +36,7 @@ use pendulum_process::pipeline::Context;
 use pendulum_process::{ProcessError, Role};
 use serde::{Deserialize, Serialize};
 
-use crate::screen::{ols, stepwise, with_candidate, Base, Candidate};
+use crate::screen::{ols, stepwise, stepwise_from, with_candidate, Base, Candidate};
 use crate::weak::{weak_rows, WeakConfig, WeakRow};
 
 /// Discovery settings.
@@ -120,6 +127,149 @@ pub struct Discovery {
     pub validation_final: Vec<RunFit>,
     /// Where unexplained structure lives, if any.
     pub unexplained: Option<String>,
+}
+
+/// Exact corrections of the measured motion for accepted effects that enter the equation of
+/// motion nonlinearly.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+struct Correction {
+    /// Encoder offset, rad: the view uses θ_meas − θ_off.
+    theta_off_rad: f64,
+    /// Accelerometer lag, s: the forcing's t = 0 is the measured one minus Δ.
+    delay_s: f64,
+}
+
+/// The weak-form equation-error view of a campaign: its rows (with per-run zeroing-error
+/// contrasts and regression weights), which run each belongs to, and the identify and validate
+/// subsets.
+#[derive(Debug, Clone)]
+struct View {
+    weak: Vec<WeakRow>,
+    weak_runs: Vec<(String, Role)>,
+    zero_cols: Vec<usize>,
+    id_rows: Vec<WeakRow>,
+    val_rows: Vec<WeakRow>,
+    correction: Correction,
+}
+
+impl View {
+    fn build(
+        ctx: &Context,
+        alignments: &std::collections::BTreeMap<String, pendulum_process::Alignment>,
+        base: Base,
+        cfg: &WeakConfig,
+        correction: Correction,
+    ) -> View {
+        let mut weak = Vec::new();
+        let mut weak_runs = Vec::new();
+        for (i, run) in ctx.runs.iter().enumerate() {
+            let Some(al) = alignments.get(&run.id) else {
+                continue;
+            };
+            let mut al = al.clone();
+            al.t0_s -= correction.delay_s;
+            let rows = if correction.theta_off_rad != 0.0 {
+                let mut r2 = run.clone();
+                r2.theta_rad
+                    .iter_mut()
+                    .for_each(|t| *t -= correction.theta_off_rad);
+                weak_rows(i, &r2, &al, cfg)
+            } else {
+                weak_rows(i, run, &al, cfg)
+            };
+            for mut r in rows {
+                r.run = weak_runs.len();
+                weak.push(r);
+            }
+            weak_runs.push((run.id.clone(), run.role));
+        }
+        // The encoder's per-run zeroing errors are nuisance terms of every model.
+        let id_idx: Vec<usize> = (0..weak_runs.len())
+            .filter(|&i| weak_runs[i].1 == Role::Identify && weak.iter().any(|r| r.run == i))
+            .collect();
+        let zero_cols = crate::weak::add_zero_error_contrasts(&mut weak, &id_idx);
+        let is_id = |r: &WeakRow| weak_runs[r.run].1 == Role::Identify;
+        // Weights from the residual variance of the whole catalogue's fit (so that a missing
+        // effect's own torque does not count as noise and down-weight where it lives).
+        {
+            let id_rows: Vec<WeakRow> = weak.iter().filter(|r| is_id(r)).cloned().collect();
+            let all: Vec<usize> = (0..=crate::weak::DELAY).chain(zero_cols.clone()).collect();
+            let base_cols: Vec<usize> = base
+                .columns()
+                .into_iter()
+                .chain(zero_cols.clone())
+                .collect();
+            if let Some(full) = ols(&id_rows, &all).or_else(|| ols(&id_rows, &base_cols)) {
+                let res = full.residuals(&weak);
+                crate::weak::set_weights(&mut weak, &res);
+            }
+        }
+        let id_rows: Vec<WeakRow> = weak.iter().filter(|r| is_id(r)).cloned().collect();
+        let val_rows: Vec<WeakRow> = weak
+            .iter()
+            .filter(|r| weak_runs[r.run].1 == Role::Validate)
+            .cloned()
+            .collect();
+        View {
+            weak,
+            weak_runs,
+            zero_cols,
+            id_rows,
+            val_rows,
+            correction,
+        }
+    }
+
+    /// Weighted squared equation error of the validate rows under `fit` (coefficients from the
+    /// identify runs). Each validate run's own encoder zeroing error is refitted for every model
+    /// (as its initial state is for E_θ): it is a nuisance of the run, not a prediction of the
+    /// model.
+    fn sq_val(&self, fit: &crate::screen::Ols) -> Vec<f64> {
+        let rows = &self.val_rows;
+        let mut res = fit.residuals(rows);
+        let runs: std::collections::BTreeSet<usize> = rows.iter().map(|r| r.run).collect();
+        for run in runs {
+            let idx: Vec<usize> = (0..rows.len()).filter(|&i| rows[i].run == run).collect();
+            let (mut sxy, mut sxx) = (0.0, 0.0);
+            for &i in &idx {
+                let (x, w) = (rows[i].x[crate::weak::OFFSET], rows[i].weight);
+                sxy += w * x * res[i];
+                sxx += w * x * x;
+            }
+            if sxx > 0.0 {
+                for &i in &idx {
+                    res[i] -= sxy / sxx * rows[i].x[crate::weak::OFFSET];
+                }
+            }
+        }
+        res.iter()
+            .zip(rows)
+            .map(|(e, r)| r.weight * e * e)
+            .collect()
+    }
+
+    /// `values` (one per row of this view) carried over to the rows of `other` (same runs):
+    /// each takes the value of this view's row of the same run whose window centre is nearest
+    /// in measured time, if within `tol_s`; NaN otherwise. (A corrected view's windows can sit
+    /// elsewhere: its t = 0 moves with an accelerometer lag, and its rest exclusions with θ.)
+    fn matched_to(&self, other: &View, values: &[f64], tol_s: f64) -> Vec<f64> {
+        let shift = self.correction.delay_s - other.correction.delay_s;
+        other
+            .weak
+            .iter()
+            .map(|o| {
+                let id = &other.weak_runs[o.run].0;
+                self.weak
+                    .iter()
+                    .zip(values)
+                    .filter(|(r, _)| &self.weak_runs[r.run].0 == id)
+                    .map(|(r, v)| ((r.tau_s - shift - o.tau_s).abs(), *v))
+                    .filter(|(d, _)| *d <= tol_s)
+                    .min_by(|a, b| a.0.total_cmp(&b.0))
+                    .map_or(f64::NAN, |(_, v)| v)
+            })
+            .collect()
+    }
 }
 
 /// Scales from the first identify run's rig.
@@ -749,99 +899,38 @@ pub fn discover(
     let weak_ctx = ctx_drift.as_ref().unwrap_or(ctx);
 
     // The equation-error view of every run.
-    let mut weak = Vec::new();
-    let mut weak_runs = Vec::new();
-    for (i, run) in ctx.runs.iter().enumerate() {
-        if let Some(al) = weak_ctx.alignments.get(&run.id) {
-            for mut r in weak_rows(i, run, al, &cfg.weak) {
-                r.run = weak_runs.len();
-                weak.push(r);
-            }
-            weak_runs.push((run.id.clone(), run.role));
-        }
-    }
-    // The encoder's per-run zeroing errors are nuisance terms of every model.
-    let id_idx: Vec<usize> = (0..weak_runs.len())
-        .filter(|&i| weak_runs[i].1 == Role::Identify && weak.iter().any(|r| r.run == i))
-        .collect();
-    let zero_cols = crate::weak::add_zero_error_contrasts(&mut weak, &id_idx);
+    let view0 = View::build(
+        ctx,
+        &weak_ctx.alignments,
+        base,
+        &cfg.weak,
+        Correction::default(),
+    );
+    let mut view = view0.clone();
+    let zero_cols = view0.zero_cols.clone();
     let base_cols: Vec<usize> = base
         .columns()
         .into_iter()
         .chain(zero_cols.clone())
         .collect();
-    // Weights from the residual variance of the whole catalogue's fit (so that a missing effect's
-    // own torque does not count as noise and down-weight where it lives).
-    {
-        let id_rows: Vec<WeakRow> = weak
-            .iter()
-            .filter(|r| weak_runs[r.run].1 == Role::Identify)
-            .cloned()
-            .collect();
-        let all: Vec<usize> = (0..=crate::weak::DELAY).chain(zero_cols.clone()).collect();
-        if let Some(full) = ols(&id_rows, &all).or_else(|| ols(&id_rows, &base_cols)) {
-            let res = full.residuals(&weak);
-            crate::weak::set_weights(&mut weak, &res);
-        }
-    }
-    let id_rows: Vec<WeakRow> = weak
-        .iter()
-        .filter(|r| weak_runs[r.run].1 == Role::Identify)
-        .cloned()
-        .collect();
-    let val_rows: Vec<WeakRow> = weak
-        .iter()
-        .filter(|r| weak_runs[r.run].1 == Role::Validate)
-        .cloned()
-        .collect();
-    // Held-out equation error: coefficients fitted on the identify runs, scored on the validate runs.
-    // Each validate run's own encoder zeroing error is refitted for every model (as its initial
-    // state is for E_θ): it is a nuisance of the run, not a prediction of the model.
-    let sq_val = |fit: &crate::screen::Ols| -> Vec<f64> {
-        let mut res = fit.residuals(&val_rows);
-        for run in val_rows
-            .iter()
-            .map(|r| r.run)
-            .collect::<std::collections::BTreeSet<_>>()
-        {
-            let idx: Vec<usize> = (0..val_rows.len())
-                .filter(|&i| val_rows[i].run == run)
-                .collect();
-            let (mut sxy, mut sxx) = (0.0, 0.0);
-            for &i in &idx {
-                let (x, w) = (val_rows[i].x[crate::weak::OFFSET], val_rows[i].weight);
-                sxy += w * x * res[i];
-                sxx += w * x * x;
-            }
-            if sxx > 0.0 {
-                for &i in &idx {
-                    res[i] -= sxy / sxx * val_rows[i].x[crate::weak::OFFSET];
-                }
-            }
-        }
-        res.iter()
-            .zip(&val_rows)
-            .map(|(e, r)| r.weight * e * e)
-            .collect()
-    };
-    let base_ols = ols(&id_rows, &base_cols).ok_or_else(|| ProcessError::Run {
+    let base_ols = ols(&view0.id_rows, &base_cols).ok_or_else(|| ProcessError::Run {
         run: "(identify runs)".into(),
         reason: format!(
             "too few usable equation-error windows ({}) for the screen",
-            id_rows.len()
+            view0.id_rows.len()
         ),
     })?;
-    let residual_base = base_ols.residuals(&weak);
+    let residual_base = base_ols.residuals(&view0.weak);
 
     // Screen.
     let screened = stepwise(
-        &id_rows,
+        &view0.id_rows,
         base,
         &zero_cols,
         cfg.screen_threshold,
         cfg.max_effects,
     );
-    let (chosen, first_round) = (&screened.chosen, &screened.first_round);
+    let first_round = &screened.first_round;
 
     // The base model on the held-out runs.
     let v1 = validate(&val_runs, &base_fit.spec, &base_fit.params, &cfg.validate)?;
@@ -877,11 +966,14 @@ pub fn discover(
     let mut baseline: Option<Vec<RunFit>> = None;
     let mut rows: Vec<DiagnosisRow> = Vec::new();
     let mut confirmed: Vec<(String, DiagnosisRow)> = Vec::new();
-    for (round, sc) in chosen.iter().enumerate() {
+    let mut correction = Correction::default();
+    let mut next = screened.chosen.first().cloned();
+    let mut round = 0;
+    while let Some(sc) = next.take() {
         let c = &sc.candidate;
         let cols = with_candidate(&current_cols, c);
-        let Some(fit) = ols(&id_rows, &cols) else {
-            continue;
+        let Some(fit) = ols(&view.id_rows, &cols) else {
+            break;
         };
         let (est, se, unit) = to_si(c, &fit, &s);
         let (spec, news) = extend(&current.spec, c, &fit, &s);
@@ -944,23 +1036,17 @@ pub fn discover(
         let after = e_total(&val);
         let (gain, noise) = heldout_gain(before_val, &val);
         let gain_needed = cfg.gain_min.max(noise);
-        let (eq_gain, eq_noise) = match ols(&id_rows, &current_cols) {
-            Some(f0) => paired_gain(&sq_val(&f0), &sq_val(&fit)),
+        let (eq_gain, eq_noise) = match ols(&view.id_rows, &current_cols) {
+            Some(f0) => paired_gain(&view.sq_val(&f0), &view.sq_val(&fit)),
             None => (f64::NAN, f64::INFINITY),
         };
         let eq_needed = cfg.eq_gain_min.max(eq_noise);
         let ci = (est - 1.96 * se, est + 1.96 * se);
         let excludes_zero = ci.0 > 0.0 || ci.1 < 0.0;
-        // A first effect needs one of the two held-out measures; a second one, added to a model
-        // already extended, needs both (a pair must not be a first effect's leftovers).
-        // On the equation error alone, E_θ may not rise by more than its own noise: near the
+        // Either held-out measure will do. On the equation error alone, E_θ may not rise by more than its own noise: near the
         // study's setting the validate runs' segments scatter by ±10–20 %, more than a dry torque
         // that μ half absorbs moves them, while their equation error tells the models apart.
-        let held_out = if round == 0 {
-            gain > gain_needed || (eq_gain > eq_needed && gain > -noise)
-        } else {
-            gain > gain_needed && eq_gain > eq_needed
-        };
+        let held_out = gain > gain_needed || (eq_gain > eq_needed && gain > -noise);
         let accepted = excludes_zero
             && practically_significant(&c.effect, est)
             && sc.delta_bic < cfg.screen_threshold
@@ -1014,6 +1100,41 @@ pub fn discover(
                 noise
             ),
         };
+        let mut row = row;
+        if accepted {
+            // An effect that enters nonlinearly is applied exactly to the measured motion (and its
+            // estimate refined by re-estimating on the corrected view), so that its linearised
+            // remainder is not mistaken for a second effect or left as `unexplained`.
+            if matches!(c.effect.as_str(), "encoder_offset" | "accel_delay") {
+                for _ in 0..3 {
+                    match c.effect.as_str() {
+                        "encoder_offset" => correction.theta_off_rad = row.estimate,
+                        _ => correction.delay_s = row.estimate,
+                    }
+                    view = View::build(ctx, &weak_ctx.alignments, base, &cfg.weak, correction);
+                    let Some(f2) = ols(&view.id_rows, &cols) else {
+                        break;
+                    };
+                    // The corrected view's column holds what is left of the effect.
+                    let (step, _, _) = to_si(c, &f2, &s);
+                    row.estimate += step;
+                    row.ci_low += step;
+                    row.ci_high += step;
+                    if step.abs() < 1e-3 * row.estimate.abs() {
+                        break;
+                    }
+                }
+                match c.effect.as_str() {
+                    "encoder_offset" => correction.theta_off_rad = row.estimate,
+                    _ => correction.delay_s = row.estimate,
+                }
+                view = View::build(ctx, &weak_ctx.alignments, base, &cfg.weak, correction);
+                row.note.push_str(&format!(
+                    "; applied exactly to the equation-error view (refined estimate {:.4e} {unit})",
+                    row.estimate
+                ));
+            }
+        }
         confirmed.push((c.effect.clone(), row.clone()));
         if accepted {
             let ev = refit_objective(&id_runs, &spec);
@@ -1043,6 +1164,13 @@ pub fn discover(
             current_val = val;
             current_cols = cols;
             baseline = None;
+            round += 1;
+            if round < cfg.max_effects {
+                // Re-screen what is left (on the corrected view, if one was built).
+                let sw = stepwise_from(&view.id_rows, base, &current_cols, cfg.screen_threshold, 1);
+                current_cols.extend(sw.nuisance.iter().copied());
+                next = sw.chosen.first().cloned();
+            }
         } else {
             break;
         }
@@ -1084,15 +1212,18 @@ pub fn discover(
     }
 
     // What stays unexplained, and where.
-    let final_ols = ols(&id_rows, &current_cols).unwrap_or(base_ols.clone());
-    let residual_final = final_ols.residuals(&weak);
-    let id_mask: Vec<bool> = weak
+    let final_ols = ols(&view.id_rows, &current_cols).unwrap_or(base_ols.clone());
+    let final_res = final_ols.residuals(&view.weak);
+    let residual_final = view.matched_to(&view0, &final_res, cfg.weak.half_width_s);
+    let id_mask: Vec<bool> = view
+        .weak
         .iter()
-        .map(|r| weak_runs[r.run].1 == Role::Identify)
+        .map(|r| view.weak_runs[r.run].1 == Role::Identify)
         .collect();
     let pick = |f: &dyn Fn(&WeakRow) -> f64| -> (Vec<f64>, Vec<f64>) {
-        weak.iter()
-            .zip(&residual_final)
+        view.weak
+            .iter()
+            .zip(&final_res)
             .zip(&id_mask)
             .filter(|(_, m)| **m)
             .map(|((r, e), _)| (f(r), *e))
@@ -1164,8 +1295,8 @@ pub fn discover(
         validation_base: v1,
         extended,
         rows,
-        weak,
-        weak_runs,
+        weak: view0.weak,
+        weak_runs: view0.weak_runs,
         residual_base,
         residual_final,
         unexplained,

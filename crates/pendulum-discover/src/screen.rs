@@ -273,8 +273,21 @@ pub fn stepwise(
     threshold: f64,
     max_effects: usize,
 ) -> Stepwise {
-    let mut current = base.columns();
-    current.extend_from_slice(extra);
+    let mut start = base.columns();
+    start.extend_from_slice(extra);
+    stepwise_from(rows, base, &start, threshold, max_effects)
+}
+
+/// [`stepwise`] from given columns (a model already extended): candidates whose columns are
+/// all in already cannot lower BIC and so are never chosen again.
+pub fn stepwise_from(
+    rows: &[WeakRow],
+    base: Base,
+    start: &[usize],
+    threshold: f64,
+    max_effects: usize,
+) -> Stepwise {
+    let mut current = start.to_vec();
     let mut chosen: Vec<Screened> = Vec::new();
     let mut first_round = Vec::new();
     let mut nuisance = Vec::new();

@@ -564,7 +564,7 @@ fn write_report(
     for (p, v) in d.base.spec.params.iter().zip(&d.base.params) {
         let _ = writeln!(r, "- {} = {:.5} {}", p.name(), v, p.unit());
     }
-    let _ = writeln!(r, "\n## Diagnosis\n\nOne row per catalogue candidate screened (ΔBIC of the weak-form equation error on the identify runs); the best are refitted on the trajectories and accepted only if their 95 % interval excludes zero and the error on the validate runs falls by more than the validation's own noise.\n\n```\n{table}```\n");
+    let _ = writeln!(r, "\n## Diagnosis\n\nOne row per catalogue candidate screened (ΔBIC of the weak-form equation error on the identify runs); the best are refitted on the trajectories and accepted only if their 95 % interval excludes zero and the error on the validate runs, which neither the screen nor the refit saw, falls by more than chance explains: E_θ by more than max(2 %, its noise), or the equation error by more than max(5 %, its noise) while E_θ does not rise by more than its noise. A fall's noise is 1.96 × its standard error from the paired differences of the validate runs' 0.5 s shooting segments (E_θ) or weak-form windows (equation error); `gain ± noise` and `eq gain` in the table.\n\n```\n{table}```\n");
     match &d.unexplained {
         Some(u) => {
             let _ = writeln!(r, "**Unexplained:** {u}.\n");
