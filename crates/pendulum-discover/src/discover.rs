@@ -289,7 +289,13 @@ impl Scales {
 
 /// SI estimate and standard error of a candidate from an OLS, and its unit.
 fn to_si(c: &Candidate, fit: &crate::screen::Ols, s: &Scales) -> (f64, f64, &'static str) {
-    let first = |col: usize| fit.coef_of(col).unwrap_or((f64::NAN, f64::NAN));
+    // With extra inertia in the regression every other coefficient is its term over (1 + j)
+    // (see "extra_inertia" below): 1 + j = 1/(1 − c).
+    let k_in = inertia_factor(fit);
+    let first = |col: usize| {
+        fit.coef_of(col)
+            .map_or((f64::NAN, f64::NAN), |(v, e)| (v * k_in, e * k_in))
+    };
     match c.effect.as_str() {
         "viscous_linear" => {
             // β = b/(m ω0).
@@ -326,7 +332,7 @@ fn to_si(c: &Candidate, fit: &crate::screen::Ols, s: &Scales) -> (f64, f64, &'st
         "extra_inertia" => {
             // (1 + j)θ̈ = −G − D makes the target ∫K(jθ̈ + D) = c·(−∫KG) + ∫KD/(1 + j) with
             // c = j/(1 + j) exactly, so j = c/(1 − c) (and dj/dc = 1/(1 − c)²).
-            let (c, e) = first(14);
+            let (c, e) = fit.coef_of(14).unwrap_or((f64::NAN, f64::NAN));
             let k = s.m * s.l * s.l;
             let one_minus = (1.0 - c).max(1e-9);
             (k * c / one_minus, k * e / (one_minus * one_minus), "kg·m²")
@@ -340,6 +346,15 @@ fn to_si(c: &Candidate, fit: &crate::screen::Ols, s: &Scales) -> (f64, f64, &'st
             (v / s.w0, e / s.w0, "s")
         }
         _ => (f64::NAN, f64::NAN, "-"),
+    }
+}
+
+/// 1 + j = 1/(1 − c) when the fit has the inertia column (coefficient c = j/(1 + j)), else 1:
+/// the factor every other coefficient of that fit is low by.
+fn inertia_factor(fit: &crate::screen::Ols) -> f64 {
+    match fit.coef_of(14) {
+        Some((c, _)) if c.is_finite() && c < 0.5 => 1.0 / (1.0 - c),
+        _ => 1.0,
     }
 }
 
@@ -992,10 +1007,7 @@ pub fn discover(
         // constant dry torque inflates μ): a local refit from there need not find its way back.
         // With extra inertia in, the regression's damping coefficients are D/(1 + j) (see
         // `to_si`): 1 + j = 1/(1 − c).
-        let inertia_scale = match fit.coef_of(14) {
-            Some((cj, _)) if c.effect == "extra_inertia" && cj < 1.0 => 1.0 / (1.0 - cj),
-            _ => 1.0,
-        };
+        let inertia_scale = inertia_factor(&fit);
         for (i, p) in spec.params.iter().enumerate() {
             let si = match p {
                 FitParam::B => fit.coef_of(0).map(|(v, _)| v * s.m * s.w0),
@@ -1349,5 +1361,19 @@ mod tests {
         assert!((est - j * s.m * s.l * s.l).abs() < 1e-15, "{est}");
         assert!((se - 1e-4 * (1.0 + j).powi(2) * s.m * s.l * s.l).abs() < 1e-12);
         assert_eq!(unit, "kg·m²");
+        // Every other term of that regression is low by 1 + j: a tilt's tan δ too.
+        let fit2 = crate::screen::Ols {
+            columns: vec![13, 14],
+            coef: vec![0.05 / (1.0 + j), j / (1.0 + j)],
+            se: vec![1e-4, 1e-4],
+            rss: 0.0,
+            n: 10,
+        };
+        let h = crate::screen::candidates(Base::Reference)
+            .into_iter()
+            .find(|c| c.effect == "horizontal_base")
+            .unwrap();
+        let (d, _, _) = to_si(&h, &fit2, &s);
+        assert!((d - 0.05_f64.atan()).abs() < 1e-12, "{d}");
     }
 }
