@@ -1,6 +1,9 @@
 //! `discover` on an 8-run twin campaign (5 identify + 3 validate, both formats, realistic
 //! sensors) with a hidden constant dry torque, with the built-in pipeline (base fit to its
-//! default generation cap), timed on all cores. `cargo bench --bench discover`. Prints only.
+//! default generation cap), timed on all cores. `cargo bench --bench discover`. Prints only:
+//! the time, and its ratio to a baseline measured in the same run, `identify` on the same
+//! campaign with the same model and generation cap (the base fit discover starts from), so the
+//! ratio is discover's own cost on top of it whatever the machine.
 
 use std::time::Instant;
 
@@ -31,10 +34,27 @@ fn main() {
         progress: false,
     })
     .expect("discover");
+    let t_discover = t.elapsed().as_secs_f64();
+    let t = Instant::now();
+    pendulum_jobs::identify::run(&pendulum_jobs::identify::IdentifyJob {
+        input: dir.path().join("c"),
+        out: dir.path().join("identify"),
+        pipeline: None,
+        overrides: pendulum_jobs::identify::FitOverrides {
+            model: Some("reference".into()),
+            // discover.toml's cap.
+            generations: Some(400),
+            ..Default::default()
+        },
+        progress: false,
+        free_segments: false,
+    })
+    .expect("identify");
+    let t_identify = t.elapsed().as_secs_f64();
     println!(
-        "discover, 8 runs, {} threads: {:.1} s",
+        "discover, 8 runs, {} threads: {t_discover:.1} s; baseline identify (same model and cap): {t_identify:.1} s; ratio {:.2}",
         rayon::current_num_threads(),
-        t.elapsed().as_secs_f64()
+        t_discover / t_identify
     );
     let accepted: Vec<&str> = s
         .discovery
