@@ -76,6 +76,15 @@ fn load(path: Option<&Path>) -> Result<DiscoverPipeline, JobError> {
 }
 
 /// The diagnosis as a short table.
+/// A fraction as a percentage, `-` when not measured (NaN).
+fn pct(v: f64) -> String {
+    if v.is_nan() {
+        "-".into()
+    } else {
+        format!("{:.1}%", 100.0 * v)
+    }
+}
+
 pub fn diagnosis_table(d: &Discovery) -> String {
     let mut t = String::new();
     let _ = writeln!(
@@ -93,7 +102,7 @@ pub fn diagnosis_table(d: &Discovery) -> String {
     for r in &d.rows {
         let _ = writeln!(
             t,
-            "{:<24} {:>8} {:>12.4e} [{:>10.3e}, {:>10.3e}] {:<6} {:>9.1} {:>7.1}% ±{:>5.1}% {:>7.1}%",
+            "{:<24} {:>8} {:>12.4e} [{:>10.3e}, {:>10.3e}] {:<6} {:>9.1} {:>8} ±{:>6} {:>8}",
             r.effect,
             if r.accepted { "YES" } else { "no" },
             r.estimate,
@@ -101,9 +110,9 @@ pub fn diagnosis_table(d: &Discovery) -> String {
             r.ci_high,
             r.unit,
             r.delta_bic,
-            100.0 * r.heldout_gain,
-            100.0 * r.heldout_noise,
-            100.0 * r.heldout_eq_gain
+            pct(r.heldout_gain),
+            pct(r.heldout_noise),
+            pct(r.heldout_eq_gain)
         );
     }
     t
