@@ -56,12 +56,6 @@ fn main() {
         rayon::current_num_threads(),
         t_discover / t_identify
     );
-    let accepted: Vec<&str> = s
-        .discovery
-        .rows
-        .iter()
-        .filter(|r| r.accepted)
-        .map(|r| r.effect.as_str())
-        .collect();
+    let accepted = s.discovery.accepted();
     println!("accepted: {accepted:?} (hidden: coulomb_constant 0.01 N·m)");
 }

@@ -129,6 +129,17 @@ pub struct Discovery {
     pub unexplained: Option<String>,
 }
 
+impl Discovery {
+    /// The catalogue names of the accepted effects, in the order they were accepted.
+    pub fn accepted(&self) -> Vec<&str> {
+        self.rows
+            .iter()
+            .filter(|r| r.accepted)
+            .map(|r| r.effect.as_str())
+            .collect()
+    }
+}
+
 /// Exact corrections of the measured motion for accepted effects that enter the equation of
 /// motion nonlinearly.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
