@@ -36,10 +36,34 @@ fn discover(seed: u64, base: Base, a: f64, b: f64, mu: f64, effects: &str) -> Di
         "report.md",
         "signatures.png",
         "params.parquet",
+        "envelopes.parquet",
+        "envelopes.png",
     ] {
         assert!(Path::new(&s.out_dir).join(f).is_file(), "{f} missing");
     }
     s
+}
+
+/// The catalogue terms the pooled free-segment envelopes name (see `pooled_envelope`); its
+/// viscous term, where named, must be the twin's β = b/(m ω0) with b = 0.3 N·s/m within 5 %.
+fn pooled_terms(s: &DiscoverSummary) -> Vec<&'static str> {
+    let fits: Vec<&pendulum_explain::EnvelopeFit> = s
+        .envelopes
+        .iter()
+        .filter_map(|(_, e)| e.as_ref().ok())
+        .collect();
+    assert_eq!(fits.len(), 8, "every run's free segment read");
+    let pooled = pendulum_jobs::discover::pooled_envelope(&fits);
+    eprintln!("pooled envelope: {pooled:?}");
+    if let Some(t) = pooled.iter().find(|t| t.name == "viscous_linear") {
+        let beta = 0.3 / (1.46 * (9.81_f64 / 0.265).sqrt());
+        assert!(
+            (t.estimate / beta - 1.0).abs() < 0.05,
+            "β {} vs {beta}",
+            t.estimate
+        );
+    }
+    pooled.iter().map(|t| t.name).collect()
 }
 
 /// Exactly `effect` accepted, its estimate within `rel` (or `abs`) of the truth, positive gain.
@@ -109,12 +133,17 @@ fn regression_issue_5_nothing_hidden_nothing_named() {
 /// The study's headline: the classic linear model on data with dry friction.
 #[test]
 fn regression_issue_5_linear_base_finds_bearing_friction() {
-    found_when_hidden("coulomb_bearing", 1, 107);
+    let s = found_when_hidden("coulomb_bearing", 1, 107);
+    // The free segments' envelopes, pooled, say the same: viscous plus load-dependent dry
+    // friction, no drag.
+    assert_eq!(pooled_terms(&s), ["viscous_linear", "coulomb_bearing"]);
 }
 
 #[test]
 fn regression_issue_5_linear_base_finds_quadratic_drag() {
-    found_when_hidden("viscous_quadratic", 2, 111);
+    let s = found_when_hidden("viscous_quadratic", 2, 111);
+    // The free segments' envelopes, pooled: viscous plus quadratic drag, and no dry friction.
+    assert_eq!(pooled_terms(&s), ["viscous_linear", "viscous_quadratic"]);
 }
 
 #[test]
