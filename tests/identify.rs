@@ -49,47 +49,46 @@ fn identify(dir: &Path, out: &Path, model: &str) -> pendulum_jobs::outputs::Outp
     .unwrap()
 }
 
-pub(crate) fn column_f64(path: &Path, name: &str) -> Vec<f64> {
-    use arrow_array::Float64Array;
+/// The arrays of one column of a Parquet file, batch by batch (panics naming the file and the
+/// column when it is missing).
+fn column_arrays(path: &Path, name: &str) -> Vec<arrow_array::ArrayRef> {
     use parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
     let f = std::fs::File::open(path).unwrap();
-    let mut out = Vec::new();
-    for b in ParquetRecordBatchReaderBuilder::try_new(f)
+    ParquetRecordBatchReaderBuilder::try_new(f)
         .unwrap()
         .build()
         .unwrap()
-    {
-        let b = b.unwrap();
-        let c = b
-            .column_by_name(name)
-            .unwrap_or_else(|| panic!("{}: no column {name}", path.display()));
-        out.extend(
-            c.as_any()
-                .downcast_ref::<Float64Array>()
-                .unwrap()
-                .values()
-                .iter(),
-        );
-    }
-    out
+        .map(|b| {
+            b.unwrap()
+                .column_by_name(name)
+                .unwrap_or_else(|| panic!("{}: no column {name}", path.display()))
+                .clone()
+        })
+        .collect()
+}
+
+pub(crate) fn column_f64(path: &Path, name: &str) -> Vec<f64> {
+    use arrow_array::Float64Array;
+    column_arrays(path, name)
+        .iter()
+        .flat_map(|c| {
+            let a = c.as_any().downcast_ref::<Float64Array>().unwrap();
+            a.values().to_vec()
+        })
+        .collect()
 }
 
 pub(crate) fn column_str(path: &Path, name: &str) -> Vec<String> {
     use arrow_array::{Array, StringArray};
-    use parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
-    let f = std::fs::File::open(path).unwrap();
-    let mut out = Vec::new();
-    for b in ParquetRecordBatchReaderBuilder::try_new(f)
-        .unwrap()
-        .build()
-        .unwrap()
-    {
-        let b = b.unwrap();
-        let c = b.column_by_name(name).unwrap();
-        let a = c.as_any().downcast_ref::<StringArray>().unwrap();
-        out.extend((0..a.len()).map(|i| a.value(i).to_string()));
-    }
-    out
+    column_arrays(path, name)
+        .iter()
+        .flat_map(|c| {
+            let a = c.as_any().downcast_ref::<StringArray>().unwrap();
+            (0..a.len())
+                .map(|i| a.value(i).to_string())
+                .collect::<Vec<_>>()
+        })
+        .collect()
 }
 
 /// Reference data (a = 0, b = 0.5, μ = 0.15): b and μ within 10 %, a < 0.05, the validate runs'
