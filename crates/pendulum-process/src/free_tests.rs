@@ -20,9 +20,15 @@ const OFFSET: f64 = 0.002;
 /// Released from 0.8 rad after a 0.3 s hold, 1 kHz, 40000-count encoder, centre off by
 /// `OFFSET`; m, l, r and Ω unknown (NaN / None), as a time-series campaign may leave them.
 fn synthetic_decay() -> RunData {
+    synthetic_decay_with(BETA, M_BEARING, 0.0)
+}
+
+/// [`synthetic_decay`] with given β, bearing friction M and constant dry torque c (per m g l).
+fn synthetic_decay_with(beta: f64, m_coulomb: f64, c: f64) -> RunData {
     let d = Dimensionless {
-        beta: BETA,
-        m_coulomb: M_BEARING,
+        beta,
+        m_coulomb,
+        c,
         ..Dimensionless::conservative()
     };
     let model = Model::with_excitation(d, Excitation::None);
@@ -124,4 +130,45 @@ fn free_decay_fit_recovers_omega0_and_damping() {
     assert!((m - M_BEARING).abs() < 0.02 * M_BEARING, "M {m}");
     assert!((off - OFFSET).abs() < 2e-4, "offset {off}");
     assert!(fit.runs[0].steady_agrees(), "{:?}", fit.runs[0]);
+}
+
+/// The free-decay fit's constant dry torque term (`coulomb_constant` → c per m g l): a decay with
+/// viscous damping and a constant dry torque only, fitted as linear + `coulomb_constant`, gives
+/// back β and c.
+#[test]
+fn free_decay_fit_recovers_constant_dry_torque() {
+    const C: f64 = 0.004;
+    let run = synthetic_decay_with(BETA, 0.0, C);
+    let al = align(&run, &AlignConfig::default()).expect("free-decay alignment");
+    let ic = estimate_state(&run, al.t0_s, &IcConfig::default()).expect("initial state");
+    let steady_cfg = SteadyConfig::default();
+    let steady = free_steady_state(&run, al.t0_s, &steady_cfg).expect("steady");
+    let window = Window {
+        window_s: 10.0,
+        sample_hz: 100.0,
+        segment_s: Some(0.5),
+        t_sim_s: None,
+    };
+    let prepared = prepare_run(&run, &al, &ic, &steady, &steady_cfg, &window).expect("prepare");
+    let cfg = FitConfig {
+        model: "linear".into(),
+        effects: vec![FitParam::CoulombConstant],
+        window,
+        np: Some(30),
+        max_generations: 60,
+        threads: Some(1),
+        ..FitConfig::default()
+    };
+    let fit = identify(std::slice::from_ref(&prepared), &cfg, None).expect("fit");
+    assert!(
+        fit.spec.params.contains(&FitParam::DryC),
+        "{:?}",
+        fit.spec.params
+    );
+    let v = |p: FitParam| fit.spec.value_of(p, &fit.params).expect("fitted");
+    let (w, b, c) = (v(FitParam::Omega0), v(FitParam::Beta), v(FitParam::DryC));
+    eprintln!("omega0 {w} beta {b} c {c} E {}", fit.e_theta);
+    assert!((w - OMEGA0).abs() < 0.002 * OMEGA0, "omega0 {w}");
+    assert!((b - BETA).abs() < 0.02 * BETA, "beta {b}");
+    assert!((c - C).abs() < 0.02 * C, "c {c}");
 }
