@@ -369,6 +369,59 @@ pub(crate) struct OrderRule {
 /// steady stream.
 pub(crate) const CONFIRM_RECORDS: usize = 3;
 
+/// The records after a candidate that [`check_order`] looks at, read ahead from a capture's
+/// record source (the serial and SD readers share it).
+#[derive(Debug)]
+pub(crate) struct Lookahead<T> {
+    buf: std::collections::VecDeque<T>,
+    /// The record source is exhausted.
+    drained: bool,
+}
+
+impl<T> Default for Lookahead<T> {
+    fn default() -> Self {
+        Self {
+            buf: std::collections::VecDeque::with_capacity(CONFIRM_RECORDS + 1),
+            drained: false,
+        }
+    }
+}
+
+impl<T> Lookahead<T> {
+    /// Reads records until the next candidate and [`CONFIRM_RECORDS`] followers are in (fewer
+    /// at the end of the source).
+    pub(crate) fn fill<E>(
+        &mut self,
+        mut read: impl FnMut() -> Result<Option<T>, E>,
+    ) -> Result<(), E> {
+        while self.buf.len() <= CONFIRM_RECORDS && !self.drained {
+            match read()? {
+                Some(x) => self.buf.push_back(x),
+                None => self.drained = true,
+            }
+        }
+        Ok(())
+    }
+
+    /// The next candidate (None at the end) with [`check_order`]'s verdict on its raw time
+    /// `t_us`, given the last kept record's `prev` and the followers read ahead.
+    pub(crate) fn pop_checked(
+        &mut self,
+        t_us: impl Fn(&T) -> u32,
+        prev: Option<u32>,
+        rule: OrderRule,
+    ) -> Option<(T, Result<(), &'static str>)> {
+        let cand = self.buf.pop_front()?;
+        let mut next = [0u32; CONFIRM_RECORDS];
+        let k = self.buf.len().min(CONFIRM_RECORDS);
+        for (slot, x) in next.iter_mut().zip(&self.buf) {
+            *slot = t_us(x);
+        }
+        let verdict = check_order(prev, t_us(&cand), &next[..k], rule);
+        Some((cand, verdict))
+    }
+}
+
 /// Outlier rejection with a few records of lookahead, on the raw clock.
 ///
 /// A damaged record that still parses (merged serial lines, a CRC collision) nearly always has a

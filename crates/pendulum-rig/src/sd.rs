@@ -4,13 +4,12 @@
 //! The reader keeps a bounded buffer (one read chunk plus one frame), resynchronises after
 //! damage on the next sync whose frame has a valid CRC, and reports what it dropped.
 
-use std::collections::VecDeque;
 use std::io::{self, Read, Write};
 use std::path::{Path, PathBuf};
 
 use crate::capture::{
-    accel_si, check_order, theta_rad, AccelSample, Clock, Counter, EncoderSample, GapTracker,
-    Header, IngestStats, Location, OrderRule, ReadOptions, Sample, CONFIRM_RECORDS,
+    accel_si, theta_rad, AccelSample, Clock, Counter, EncoderSample, GapTracker, Header,
+    IngestStats, Location, Lookahead, OrderRule, ReadOptions, Sample,
 };
 use crate::crc8::crc8;
 use crate::error::RigError;
@@ -110,9 +109,7 @@ pub struct SdReader<R: Read> {
     dropping: Option<DropRun>,
     tail_start: Option<u64>,
     finished: bool,
-    lookahead: VecDeque<Frame>,
-    /// The record source is exhausted.
-    drained: bool,
+    lookahead: Lookahead<Frame>,
     clock: Clock,
     counter: Counter,
     enc_gaps: GapTracker,
@@ -144,8 +141,7 @@ impl<R: Read> SdReader<R> {
             dropping: None,
             tail_start: None,
             finished: false,
-            lookahead: VecDeque::with_capacity(CONFIRM_RECORDS + 1),
-            drained: false,
+            lookahead: Lookahead::default(),
             clock: Clock::default(),
             counter: Counter::default(),
             enc_gaps: GapTracker::new("encoder", 1.0, 1.0),
@@ -416,25 +412,17 @@ impl<R: Read> SdReader<R> {
     /// counted in [`Self::stats`].
     pub fn next_sample(&mut self) -> Result<Option<Sample>, RigError> {
         loop {
-            while self.lookahead.len() <= CONFIRM_RECORDS && !self.drained {
-                match self.next_data_frame()? {
-                    Some(x) => self.lookahead.push_back(x),
-                    None => self.drained = true,
-                }
-            }
-            let Some(cand) = self.lookahead.pop_front() else {
+            // Taken out while it reads, so that the reader can borrow itself.
+            let mut ahead = std::mem::take(&mut self.lookahead);
+            let filled = ahead.fill(|| self.next_data_frame());
+            self.lookahead = ahead;
+            filled?;
+            let Some((cand, verdict)) =
+                self.lookahead
+                    .pop_checked(|x| x.t_us, self.clock.last_raw(), self.order)
+            else {
                 return Ok(None);
             };
-            let mut next = [0u32; CONFIRM_RECORDS];
-            for (slot, x) in next.iter_mut().zip(&self.lookahead) {
-                *slot = x.t_us;
-            }
-            let verdict = check_order(
-                self.clock.last_raw(),
-                cand.t_us,
-                &next[..self.lookahead.len()],
-                self.order,
-            );
             let at = Location::Byte(cand.offset);
             if let Err(why) = verdict {
                 let reason = format!("frame with valid CRC dropped: {why} (t_us={})", cand.t_us);

@@ -4,13 +4,12 @@
 //! file (nor with a "line" of binary garbage that never ends).
 
 use crate::lines::{read_bounded_line, LineInfo};
-use std::collections::VecDeque;
 use std::io::{self, BufRead, Write};
 use std::path::{Path, PathBuf};
 
 use crate::capture::{
-    accel_si, check_order, snippet, theta_rad, AccelSample, Clock, Counter, EncoderSample,
-    GapTracker, Header, IngestStats, Location, OrderRule, ReadOptions, Sample, CONFIRM_RECORDS,
+    accel_si, snippet, theta_rad, AccelSample, Clock, Counter, EncoderSample, GapTracker, Header,
+    IngestStats, Location, Lookahead, OrderRule, ReadOptions, Sample,
 };
 use crate::error::RigError;
 
@@ -40,9 +39,7 @@ pub struct SerialReader<R: BufRead> {
     order: OrderRule,
     line_no: u64,
     line: Vec<u8>,
-    lookahead: VecDeque<Row>,
-    /// The record source is exhausted.
-    drained: bool,
+    lookahead: Lookahead<Row>,
     pending_accel: Option<AccelSample>,
     clock: Clock,
     counter: Counter,
@@ -68,8 +65,7 @@ impl<R: BufRead> SerialReader<R> {
             },
             line_no: 0,
             line: Vec::with_capacity(128),
-            lookahead: VecDeque::with_capacity(CONFIRM_RECORDS + 1),
-            drained: false,
+            lookahead: Lookahead::default(),
             pending_accel: None,
             clock: Clock::default(),
             counter: Counter::default(),
@@ -230,25 +226,17 @@ impl<R: BufRead> SerialReader<R> {
             return Ok(Some(Sample::Accel(a)));
         }
         loop {
-            while self.lookahead.len() <= CONFIRM_RECORDS && !self.drained {
-                match self.next_row()? {
-                    Some(x) => self.lookahead.push_back(x),
-                    None => self.drained = true,
-                }
-            }
-            let Some(cand) = self.lookahead.pop_front() else {
+            // Taken out while it reads, so that the reader can borrow itself.
+            let mut ahead = std::mem::take(&mut self.lookahead);
+            let filled = ahead.fill(|| self.next_row());
+            self.lookahead = ahead;
+            filled?;
+            let Some((cand, verdict)) =
+                self.lookahead
+                    .pop_checked(|x| x.t_us, self.clock.last_raw(), self.order)
+            else {
                 return Ok(None);
             };
-            let mut next = [0u32; CONFIRM_RECORDS];
-            for (slot, x) in next.iter_mut().zip(&self.lookahead) {
-                *slot = x.t_us;
-            }
-            let verdict = check_order(
-                self.clock.last_raw(),
-                cand.t_us,
-                &next[..self.lookahead.len()],
-                self.order,
-            );
             let t_us = match (verdict, self.clock.peek(cand.t_us)) {
                 (Ok(()), Some(t)) => t,
                 (Err(why), _) => {
