@@ -637,18 +637,14 @@ fn speed_drift_row(
         params: x,
         f_obj: eval.f_obj,
         e_theta: eval.e_theta,
-        runs: base_fit
-            .runs
-            .iter()
+        runs: eval
+            .update_runs(&base_fit.runs)
+            .into_iter()
             .zip(&id2)
-            .enumerate()
-            .map(|(j, (r, p))| RunFit {
+            .map(|(r, p)| RunFit {
                 ic_est: p.ic_est,
                 ic_fit: p.ic_est,
-                e_theta: eval.per_run_e[j],
-                segment_e: eval.per_run_segment_e[j].clone(),
-                simulated: eval.per_run_sim_steady[j],
-                ..r.clone()
+                ..r
             })
             .collect(),
         convergence: Vec::new(),
@@ -1169,17 +1165,7 @@ pub fn discover(
                 params: x.clone(),
                 f_obj: eval.f_obj,
                 e_theta: eval.e_theta,
-                runs: current
-                    .runs
-                    .iter()
-                    .enumerate()
-                    .map(|(j, r)| RunFit {
-                        e_theta: eval.per_run_e[j],
-                        segment_e: eval.per_run_segment_e[j].clone(),
-                        simulated: eval.per_run_sim_steady[j],
-                        ..r.clone()
-                    })
-                    .collect(),
+                runs: eval.update_runs(&current.runs),
                 convergence: Vec::new(),
                 stop_reason: "refit (Nelder–Mead from the base fit)".into(),
                 ..current.clone()

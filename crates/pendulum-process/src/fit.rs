@@ -760,6 +760,22 @@ pub struct Evaluation {
     pub per_run_sim_steady: Vec<Option<SteadyState>>,
 }
 
+impl Evaluation {
+    /// `runs` (one per run evaluated, in order) with this evaluation's E_θ, segment errors and
+    /// simulated steady states.
+    pub fn update_runs(&self, runs: &[crate::identify::RunFit]) -> Vec<crate::identify::RunFit> {
+        runs.iter()
+            .enumerate()
+            .map(|(j, r)| crate::identify::RunFit {
+                e_theta: self.per_run_e[j],
+                segment_e: self.per_run_segment_e[j].clone(),
+                simulated: self.per_run_sim_steady[j],
+                ..r.clone()
+            })
+            .collect()
+    }
+}
+
 impl StudyObjective<'_> {
     fn n_params(&self) -> usize {
         if self.fixed_params.is_some() {

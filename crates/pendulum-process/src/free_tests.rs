@@ -79,6 +79,35 @@ fn synthetic_decay_with(beta: f64, m_coulomb: f64, c: f64) -> RunData {
     }
 }
 
+/// Fits a prepared synthetic decay as the linear model plus `effect` (10 s window in 0.5 s
+/// shooting segments, the pipeline's default, stretched to two swings for a free decay).
+fn fit_linear_plus(
+    run: &RunData,
+    al: &crate::Alignment,
+    ic: &crate::ic::InitialState,
+    steady: &pendulum_model::SteadyState,
+    effect: FitParam,
+) -> crate::identify::FitOutcome {
+    let steady_cfg = SteadyConfig::default();
+    let window = Window {
+        window_s: 10.0,
+        sample_hz: 100.0,
+        segment_s: Some(0.5),
+        t_sim_s: None,
+    };
+    let prepared = prepare_run(run, al, ic, steady, &steady_cfg, &window).expect("prepare");
+    let cfg = FitConfig {
+        model: "linear".into(),
+        effects: vec![effect],
+        window,
+        np: Some(30),
+        max_generations: 60,
+        threads: Some(1),
+        ..FitConfig::default()
+    };
+    identify(std::slice::from_ref(&prepared), &cfg, None).expect("fit")
+}
+
 #[test]
 fn free_decay_fit_recovers_omega0_and_damping() {
     let run = synthetic_decay();
@@ -99,24 +128,7 @@ fn free_decay_fit_recovers_omega0_and_damping() {
         SteadyClass::Oscillation,
         "still swinging at 24 s"
     );
-    let window = Window {
-        window_s: 10.0,
-        sample_hz: 100.0,
-        // the pipeline's default; a free decay's segments are stretched to two swings
-        segment_s: Some(0.5),
-        t_sim_s: None,
-    };
-    let prepared = prepare_run(&run, &al, &ic, &steady, &steady_cfg, &window).expect("prepare");
-    let cfg = FitConfig {
-        model: "linear".into(),
-        effects: vec![FitParam::Mu],
-        window,
-        np: Some(30),
-        max_generations: 60,
-        threads: Some(1),
-        ..FitConfig::default()
-    };
-    let fit = identify(std::slice::from_ref(&prepared), &cfg, None).expect("fit");
+    let fit = fit_linear_plus(&run, &al, &ic, &steady, FitParam::Mu);
     let v = |p: FitParam| fit.spec.value_of(p, &fit.params).expect("fitted");
     let (w, b, m, off) = (
         v(FitParam::Omega0),
@@ -141,25 +153,8 @@ fn free_decay_fit_recovers_constant_dry_torque() {
     let run = synthetic_decay_with(BETA, 0.0, C);
     let al = align(&run, &AlignConfig::default()).expect("free-decay alignment");
     let ic = estimate_state(&run, al.t0_s, &IcConfig::default()).expect("initial state");
-    let steady_cfg = SteadyConfig::default();
-    let steady = free_steady_state(&run, al.t0_s, &steady_cfg).expect("steady");
-    let window = Window {
-        window_s: 10.0,
-        sample_hz: 100.0,
-        segment_s: Some(0.5),
-        t_sim_s: None,
-    };
-    let prepared = prepare_run(&run, &al, &ic, &steady, &steady_cfg, &window).expect("prepare");
-    let cfg = FitConfig {
-        model: "linear".into(),
-        effects: vec![FitParam::CoulombConstant],
-        window,
-        np: Some(30),
-        max_generations: 60,
-        threads: Some(1),
-        ..FitConfig::default()
-    };
-    let fit = identify(std::slice::from_ref(&prepared), &cfg, None).expect("fit");
+    let steady = free_steady_state(&run, al.t0_s, &SteadyConfig::default()).expect("steady");
+    let fit = fit_linear_plus(&run, &al, &ic, &steady, FitParam::CoulombConstant);
     assert!(
         fit.spec.params.contains(&FitParam::DryC),
         "{:?}",
