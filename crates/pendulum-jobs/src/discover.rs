@@ -554,15 +554,10 @@ fn free_segment_envelopes(ctx: &Context) -> Vec<SegmentEnvelope> {
         let Some(al) = ctx.alignments.get(&run.id) else {
             continue;
         };
-        let (a, b) = al.free_segment_s;
-        if !(b - a >= ENVELOPE_MIN_S) {
+        let Some(seg) = al.free_segment_samples(run, ENVELOPE_MIN_S) else {
             continue;
-        }
-        let (lo, hi) = (
-            run.enc_t_s.partition_point(|&t| t < a),
-            run.enc_t_s.partition_point(|&t| t <= b),
-        );
-        let env = pendulum_explain::envelope(&run.enc_t_s[lo..hi], &run.theta_rad[lo..hi])
+        };
+        let env = pendulum_explain::envelope(&run.enc_t_s[seg.clone()], &run.theta_rad[seg])
             .map_err(|e| e.to_string());
         out.push(SegmentEnvelope {
             run: run.id.clone(),

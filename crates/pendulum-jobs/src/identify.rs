@@ -58,22 +58,17 @@ pub fn free_segment_runs(ctx: &Context) -> Vec<RunData> {
         let Some(al) = ctx.alignments.get(&run.id).filter(|a| !a.is_free()) else {
             continue;
         };
-        let (t0, t1) = al.free_segment_s;
-        if !(t1 - t0 >= FREE_SEGMENT_MIN_S) {
+        let Some(seg) = al.free_segment_samples(run, FREE_SEGMENT_MIN_S) else {
             continue;
-        }
-        let (lo, hi) = (
-            run.enc_t_s.partition_point(|&t| t < t0),
-            run.enc_t_s.partition_point(|&t| t <= t1),
-        );
+        };
         let mut rig = run.rig.clone();
         rig.omega_hz = None;
         out.push(RunData {
             id: format!("{}-free", run.id),
             role: run.role,
             rig,
-            enc_t_s: run.enc_t_s[lo..hi].to_vec(),
-            theta_rad: run.theta_rad[lo..hi].to_vec(),
+            enc_t_s: run.enc_t_s[seg.clone()].to_vec(),
+            theta_rad: run.theta_rad[seg].to_vec(),
             acc_t_s: Vec::new(),
             az_m_s2: Vec::new(),
             ax_m_s2: Vec::new(),

@@ -146,6 +146,20 @@ impl Alignment {
     pub fn is_free(&self) -> bool {
         self.kind == AlignmentKind::FreeDecay
     }
+
+    /// The encoder samples of `run` inside the free-motion segment before the shaker, when the
+    /// segment lasts at least `min_s` seconds.
+    pub fn free_segment_samples(
+        &self,
+        run: &crate::RunData,
+        min_s: f64,
+    ) -> Option<std::ops::Range<usize>> {
+        let (a, b) = self.free_segment_s;
+        if !(b - a >= min_s) {
+            return None;
+        }
+        Some(run.enc_t_s.partition_point(|&t| t < a)..run.enc_t_s.partition_point(|&t| t <= b))
+    }
 }
 
 /// The alignment of a run with no shaker (see the module docs).
