@@ -283,89 +283,57 @@ impl View {
     }
 }
 
-/// Scales from the first identify run's rig.
-struct Scales {
-    m: f64,
-    l: f64,
-    g: f64,
-    r_b: f64,
-    w0: f64,
-}
-
-impl Scales {
-    fn torque(&self) -> f64 {
-        self.m * self.g * self.l
-    }
-}
-
-/// SI estimate and standard error of a candidate from an OLS, and its unit.
-fn to_si(c: &Candidate, fit: &crate::screen::Ols, s: &Scales) -> (f64, f64, &'static str) {
-    // With extra inertia in the regression every other coefficient is its term over (1 + j)
-    // (see "extra_inertia" below): 1 + j = 1/(1 − c).
-    let k_in = inertia_factor(fit);
-    let first = |col: usize| {
-        fit.coef_of(col)
-            .map_or((f64::NAN, f64::NAN), |(v, e)| (v * k_in, e * k_in))
-    };
+/// SI estimate and standard error of a candidate from an OLS, and its unit. The weak-form
+/// columns carry each run's own scale ([`crate::weak::si_factors`]) and the regression each
+/// run's inertia divisor, so the coefficients are the SI parameters themselves whatever bobs and
+/// cranks the campaign mixes.
+fn to_si(c: &Candidate, fit: &crate::screen::Ols) -> (f64, f64, &'static str) {
+    let first = |col: usize| fit.coef_of(col).unwrap_or((f64::NAN, f64::NAN));
     match c.effect.as_str() {
         "viscous_linear" => {
-            // β = b/(m ω0).
             let (v, e) = first(0);
-            (v * s.m * s.w0, e * s.m * s.w0, "N·s/m")
+            (v, e, "N·s/m")
         }
         "viscous_quadratic" => {
             let (v, e) = first(1);
-            (v * s.m / s.l, e * s.m / s.l, "kg/m")
+            (v, e, "kg/m")
         }
         "coulomb_bearing" => {
             let (v, e) = first(2);
-            (v * s.l / s.r_b, e * s.l / s.r_b, "1")
+            (v, e, "1")
         }
         "bearing_load_base_accel" => {
             let (v, e) = first(3);
-            (v * s.l / s.r_b, e * s.l / s.r_b, "1")
+            (v, e, "1")
         }
         "coulomb_constant" => {
             let (v, e) = first(4);
-            (v * s.torque(), e * s.torque(), "N·m")
+            (v, e, "N·m")
         }
         "position_torque" => {
             let (a, ea) = first(c.add[0]);
             let (b, eb) = first(c.add[1]);
             let p = a.hypot(b);
             let se = ((a * ea).powi(2) + (b * eb).powi(2)).sqrt() / p.max(1e-300);
-            (p * s.torque(), se * s.torque(), "N·m")
+            (p, se, "N·m")
         }
         "horizontal_base" => {
             let (v, e) = first(13);
-            (v.atan(), e, "rad")
+            (v.atan(), e / (1.0 + v * v), "rad")
         }
         "extra_inertia" => {
-            // (1 + j)θ̈ = −G − D makes the target ∫K(jθ̈ + D) = c·(−∫KG) + ∫KD/(1 + j) with
-            // c = j/(1 + j) exactly, so j = c/(1 − c) (and dj/dc = 1/(1 − c)²).
-            let (c, e) = fit.coef_of(14).unwrap_or((f64::NAN, f64::NAN));
-            let k = s.m * s.l * s.l;
-            let one_minus = (1.0 - c).max(1e-9);
-            (k * c / one_minus, k * e / (one_minus * one_minus), "kg·m²")
+            let (v, e) = first(crate::weak::INERTIA);
+            (v, e, "kg·m²")
         }
         "encoder_offset" => {
-            let (v, e) = first(15);
+            let (v, e) = first(crate::weak::OFFSET);
             (-v, e, "rad")
         }
         "accel_delay" => {
             let (v, e) = first(crate::weak::DELAY);
-            (v / s.w0, e / s.w0, "s")
+            (v, e, "s")
         }
         _ => (f64::NAN, f64::NAN, "-"),
-    }
-}
-
-/// 1 + j = 1/(1 − c) when the fit has the inertia column (coefficient c = j/(1 + j)), else 1:
-/// the factor every other coefficient of that fit is low by.
-fn inertia_factor(fit: &crate::screen::Ols) -> f64 {
-    match fit.coef_of(14) {
-        Some((c, _)) if c.is_finite() && c < 0.5 => 1.0 / (1.0 - c),
-        _ => 1.0,
     }
 }
 
@@ -678,10 +646,9 @@ fn extend(
     spec: &ModelSpec,
     c: &Candidate,
     fit: &crate::screen::Ols,
-    s: &Scales,
 ) -> (ModelSpec, Vec<(FitParam, f64)>) {
     let mut out = spec.clone();
-    let (est, _, _) = to_si(c, fit, s);
+    let (est, _, _) = to_si(c, fit);
     let mut news = Vec::new();
     match c.effect.as_str() {
         "viscous_linear" => news.push((FitParam::B, est.max(0.0))),
@@ -893,22 +860,13 @@ pub fn discover(
         })?;
     let mut id_runs = ctx.prepared(Role::Identify, &cfg.validate.window, "discover")?;
     let mut val_runs = ctx.prepared(Role::Validate, &cfg.validate.window, "discover")?;
-    let first = ctx
-        .runs
-        .iter()
-        .find(|r| r.role == Role::Identify)
-        .ok_or_else(|| ProcessError::BadConfig {
+    if !ctx.runs.iter().any(|r| r.role == Role::Identify) {
+        return Err(ProcessError::BadConfig {
             stage: "discover".into(),
             field: "runs".into(),
             message: "no identify runs".into(),
-        })?;
-    let s = Scales {
-        m: first.rig.m_kg,
-        l: first.rig.l_m,
-        g: first.rig.g_m_s2,
-        r_b: first.rig.r_b_m,
-        w0: first.rig.omega0_rad_s(),
-    };
+        });
+    }
 
     // A drifting crank speed, read from the accelerometer first: when it is significant the
     // equation-error view uses the re-aligned forcing, so that its growing phase error is not
@@ -997,8 +955,8 @@ pub fn discover(
         let Some(fit) = ols(&view.id_rows, &cols) else {
             break;
         };
-        let (est, se, unit) = to_si(c, &fit, &s);
-        let (spec, news) = extend(&current.spec, c, &fit, &s);
+        let (est, se, unit) = to_si(c, &fit);
+        let (spec, news) = extend(&current.spec, c, &fit);
         let mut x0: Vec<f64> = spec
             .params
             .iter()
@@ -1012,17 +970,14 @@ pub fn discover(
         // The base's damping terms start from the screen's joint estimate with the candidate in,
         // not from the base fit, whose terms absorbed what the candidate now explains (a
         // constant dry torque inflates μ): a local refit from there need not find its way back.
-        // With extra inertia in, the regression's damping coefficients are D/(1 + j) (see
-        // `to_si`): 1 + j = 1/(1 − c).
-        let inertia_scale = inertia_factor(&fit);
         for (i, p) in spec.params.iter().enumerate() {
             let si = match p {
-                FitParam::B => fit.coef_of(0).map(|(v, _)| v * s.m * s.w0),
-                FitParam::A => fit.coef_of(1).map(|(v, _)| v * s.m / s.l),
-                FitParam::Mu => fit.coef_of(2).map(|(v, _)| v * s.l / s.r_b),
+                FitParam::B => fit.coef_of(0),
+                FitParam::A => fit.coef_of(1),
+                FitParam::Mu => fit.coef_of(2),
                 _ => None,
             };
-            if let Some(v) = si.map(|v| v * inertia_scale).filter(|v| v.is_finite()) {
+            if let Some(v) = si.map(|(v, _)| v).filter(|v| v.is_finite()) {
                 x0[i] = v.max(0.0);
             }
         }
@@ -1135,7 +1090,7 @@ pub fn discover(
                         break;
                     };
                     // The corrected view's column holds what is left of the effect.
-                    let (step, _, _) = to_si(c, &f2, &s);
+                    let (step, _, _) = to_si(c, &f2);
                     row.estimate += step;
                     row.ci_low += step;
                     row.ci_high += step;
@@ -1195,7 +1150,7 @@ pub fn discover(
             rows.push(row.clone());
             continue;
         }
-        let (est, se, unit) = to_si(&sc.candidate, &sc.fit, &s);
+        let (est, se, unit) = to_si(&sc.candidate, &sc.fit);
         rows.push(DiagnosisRow {
             effect: sc.candidate.effect.clone(),
             accepted: false,
@@ -1330,47 +1285,5 @@ mod tests {
         // A uniform fall has no scatter; two units cannot be judged.
         assert_eq!(paired_gain(&[1.0; 5], &[0.9; 5]).1, 0.0);
         assert!(paired_gain(&[1.0, 2.0], &[0.5, 1.0]).1.is_infinite());
-    }
-
-    /// The inertia conversion j = c/(1 − c) inverts the regression's c = j/(1 + j).
-    #[test]
-    fn extra_inertia_from_regression_coefficient() {
-        let s = Scales {
-            m: 1.46,
-            l: 0.265,
-            g: 9.81,
-            r_b: 0.01225,
-            w0: (9.81_f64 / 0.265).sqrt(),
-        };
-        let j = 0.0946;
-        let fit = crate::screen::Ols {
-            columns: vec![14],
-            coef: vec![j / (1.0 + j)],
-            se: vec![1e-4],
-            rss: 0.0,
-            n: 10,
-        };
-        let c = crate::screen::candidates(Base::Reference)
-            .into_iter()
-            .find(|c| c.effect == "extra_inertia")
-            .unwrap();
-        let (est, se, unit) = to_si(&c, &fit, &s);
-        assert!((est - j * s.m * s.l * s.l).abs() < 1e-15, "{est}");
-        assert!((se - 1e-4 * (1.0 + j).powi(2) * s.m * s.l * s.l).abs() < 1e-12);
-        assert_eq!(unit, "kg·m²");
-        // Every other term of that regression is low by 1 + j: a tilt's tan δ too.
-        let fit2 = crate::screen::Ols {
-            columns: vec![13, 14],
-            coef: vec![0.05 / (1.0 + j), j / (1.0 + j)],
-            se: vec![1e-4, 1e-4],
-            rss: 0.0,
-            n: 10,
-        };
-        let h = crate::screen::candidates(Base::Reference)
-            .into_iter()
-            .find(|c| c.effect == "horizontal_base")
-            .unwrap();
-        let (d, _, _) = to_si(&h, &fit2, &s);
-        assert!((d - 0.05_f64.atan()).abs() < 1e-12, "{d}");
     }
 }

@@ -9,7 +9,7 @@
 use pendulum_process::linalg::{inverse, solve};
 use serde::{Deserialize, Serialize};
 
-use crate::weak::{WeakRow, DELAY, OFFSET};
+use crate::weak::{is_dynamics, WeakRow, DELAY, INERTIA, OFFSET};
 
 /// The base models discover starts from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -97,7 +97,7 @@ pub fn candidates(base: Base) -> Vec<Candidate> {
     out
 }
 
-/// An ordinary least-squares fit of the target on some columns.
+/// A weighted least-squares fit of the target on some columns.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Ols {
     pub columns: Vec<usize>,
@@ -106,6 +106,10 @@ pub struct Ols {
     pub se: Vec<f64>,
     pub rss: f64,
     pub n: usize,
+    /// Extra inertia J (kg·m²) the dynamics columns were divided by (1 + J/(m l²) per run);
+    /// 0 without the inertia column.
+    #[serde(default)]
+    pub inertia_kg_m2: f64,
 }
 
 impl Ols {
@@ -131,25 +135,145 @@ impl Ols {
                         .columns
                         .iter()
                         .zip(&self.coef)
-                        .map(|(&c, b)| r.x[c] * b)
+                        .map(|(&c, b)| design(r, c, self.inertia_kg_m2) * b)
                         .sum::<f64>()
             })
             .collect()
     }
 }
 
-/// Weighted least squares of the target on `columns` (weights [`WeakRow::weight`]; columns are
-/// scaled for conditioning). `rss` is the weighted sum of squares.
+/// 1/(1 + J/(m l²)) of the row's run: (1 + j)θ̈ = −G − D puts every dynamics term into the
+/// target divided by 1 + j (see [`crate::weak::is_dynamics`]).
+fn inertia_divisor(r: &WeakRow, inertia_kg_m2: f64) -> f64 {
+    if inertia_kg_m2 == 0.0 {
+        1.0
+    } else {
+        1.0 / (1.0 + inertia_kg_m2 / r.bob_inertia_kg_m2)
+    }
+}
+
+/// The value of column `c` in row `r` of the design, given the extra inertia J.
+fn design(r: &WeakRow, c: usize, inertia_kg_m2: f64) -> f64 {
+    if is_dynamics(c) {
+        r.x[c] * inertia_divisor(r, inertia_kg_m2)
+    } else {
+        r.x[c]
+    }
+}
+
+/// Weighted least squares of the target on `columns` (weights [`WeakRow::weight`]).
+///
+/// With the extra-inertia column in, the model T = Σ_sensor P x + (Σ_dyn P x + J x_J)/(1 + J/I_r)
+/// is linear in every parameter but J, and J enters it only through each run's divisor: it is
+/// solved by fixed-point iteration on J (each step a linear fit with the divisors of the last J;
+/// it contracts by about j per step), and the standard errors come from the Gauss–Newton
+/// Jacobian at the solution, whose J column carries the divisor's own derivative. With one bob
+/// the divisor is a common factor and this is the exact inversion j = c/(1 − c) of the old
+/// single-rig regression.
 pub fn ols(rows: &[WeakRow], columns: &[usize]) -> Option<Ols> {
+    let Some(ji) = columns.iter().position(|&c| c == INERTIA) else {
+        return ols_at(rows, columns, 0.0);
+    };
+    // The smallest bob inertia bounds J from below (1 + J/I must stay positive).
+    let i_min = rows
+        .iter()
+        .map(|r| r.bob_inertia_kg_m2)
+        .filter(|v| v.is_finite() && *v > 0.0)
+        .fold(f64::INFINITY, f64::min);
+    if !i_min.is_finite() {
+        return ols_at(rows, columns, 0.0);
+    }
+    let mut j = 0.0;
+    let mut fit = ols_at(rows, columns, j)?;
+    for _ in 0..50 {
+        let next = fit.coef[ji].max(-0.5 * i_min);
+        if !next.is_finite() {
+            break;
+        }
+        let done = (next - j).abs() <= 1e-10 * (i_min + next.abs());
+        j = next;
+        fit = ols_at(rows, columns, j)?;
+        if done {
+            break;
+        }
+    }
+    // Standard errors from the Jacobian: ∂T/∂J = f x_J − f² S / I with S = Σ_dyn P x + J x_J.
+    let p = columns.len();
+    let jac = |r: &WeakRow, i: usize| -> f64 {
+        if i != ji {
+            return design(r, columns[i], j);
+        }
+        let f = inertia_divisor(r, j);
+        let s: f64 = columns
+            .iter()
+            .zip(&fit.coef)
+            .filter(|(c, _)| is_dynamics(**c))
+            .map(|(&c, b)| r.x[c] * b)
+            .sum();
+        f * r.x[INERTIA] - f * f * s / r.bob_inertia_kg_m2
+    };
+    if let Some(se) = weighted_se(rows, p, fit.rss, &jac) {
+        fit.se = se;
+    }
+    Some(fit)
+}
+
+/// Standard errors s·sqrt(diag (AᵀWA)⁻¹) of a design given by `col(row, i)`.
+fn weighted_se(
+    rows: &[WeakRow],
+    p: usize,
+    rss: f64,
+    col: &dyn Fn(&WeakRow, usize) -> f64,
+) -> Option<Vec<f64>> {
+    let n = rows.iter().filter(|r| r.weight > 0.0).count();
+    if p == 0 || n <= p {
+        return None;
+    }
+    let scale: Vec<f64> = (0..p)
+        .map(|i| {
+            (rows
+                .iter()
+                .map(|r| r.weight * col(r, i).powi(2))
+                .sum::<f64>()
+                / n as f64)
+                .sqrt()
+                .max(1e-300)
+        })
+        .collect();
+    let mut ata = vec![0.0; p * p];
+    for r in rows {
+        let v: Vec<f64> = (0..p).map(|i| col(r, i) / scale[i]).collect();
+        for i in 0..p {
+            for k in 0..p {
+                ata[i * p + k] += r.weight * v[i] * v[k];
+            }
+        }
+    }
+    let inv = inverse(&ata, p)?;
+    let s2 = rss / (n - p) as f64;
+    Some(
+        (0..p)
+            .map(|i| (inv[i * p + i] * s2).max(0.0).sqrt() / scale[i])
+            .collect(),
+    )
+}
+
+/// One weighted least-squares solve with the dynamics columns divided by 1 + J/I_r for a given
+/// J (columns are scaled for conditioning). `rss` is the weighted sum of squares.
+fn ols_at(rows: &[WeakRow], columns: &[usize], inertia_kg_m2: f64) -> Option<Ols> {
     let p = columns.len();
     let n = rows.iter().filter(|r| r.weight > 0.0).count();
     if n <= p + 2 {
         return None;
     }
-    let scale: Vec<f64> = columns
-        .iter()
-        .map(|&c| {
-            (rows.iter().map(|r| r.weight * r.x[c] * r.x[c]).sum::<f64>() / n as f64)
+    let col = |r: &WeakRow, i: usize| design(r, columns[i], inertia_kg_m2);
+    let scale: Vec<f64> = (0..p)
+        .map(|i| {
+            (rows
+                .iter()
+                .map(|r| r.weight * col(r, i).powi(2))
+                .sum::<f64>()
+                / n as f64)
                 .sqrt()
                 .max(1e-300)
         })
@@ -157,11 +281,11 @@ pub fn ols(rows: &[WeakRow], columns: &[usize]) -> Option<Ols> {
     let mut ata = vec![0.0; p * p];
     let mut atb = vec![0.0; p];
     for r in rows {
+        let v: Vec<f64> = (0..p).map(|i| col(r, i) / scale[i]).collect();
         for i in 0..p {
-            let xi = r.weight * r.x[columns[i]] / scale[i];
-            atb[i] += xi * r.target;
-            for j in 0..p {
-                ata[i * p + j] += xi * r.x[columns[j]] / scale[j];
+            atb[i] += r.weight * v[i] * r.target;
+            for k in 0..p {
+                ata[i * p + k] += r.weight * v[i] * v[k];
             }
         }
     }
@@ -172,7 +296,7 @@ pub fn ols(rows: &[WeakRow], columns: &[usize]) -> Option<Ols> {
     };
     let mut rss = 0.0;
     for r in rows {
-        let fit: f64 = (0..p).map(|i| r.x[columns[i]] / scale[i] * beta[i]).sum();
+        let fit: f64 = (0..p).map(|i| col(r, i) / scale[i] * beta[i]).sum();
         rss += r.weight * (r.target - fit).powi(2);
     }
     let s2 = rss / (n - p) as f64;
@@ -189,6 +313,7 @@ pub fn ols(rows: &[WeakRow], columns: &[usize]) -> Option<Ols> {
             .collect(),
         rss,
         n,
+        inertia_kg_m2,
     })
 }
 
@@ -316,5 +441,63 @@ pub fn stepwise_from(
         chosen,
         first_round,
         nuisance,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn row(run: usize, bob: f64, x: Vec<f64>, target: f64) -> WeakRow {
+        WeakRow {
+            run,
+            tau_s: 0.0,
+            theta: 0.0,
+            theta_dot_rad_s: 0.0,
+            phase: 0.0,
+            a_y_meas: 0.0,
+            a_x_meas: 0.0,
+            target,
+            x,
+            weight: 1.0,
+            bob_inertia_kg_m2: bob,
+        }
+    }
+
+    /// Two bobs (m l² = 0.1025 and 0.0504 kg·m²) with extra inertia J = 0.008 kg·m²: the
+    /// target (Σ_dyn P x + J x_J)/(1 + J/I_r) + P_off x_off is inverted exactly, every SI
+    /// parameter back to 1e-9, where one common divisor (the single-rig conversion) is off.
+    #[test]
+    fn inertia_divisor_per_run_is_inverted_exactly() {
+        let (b, t_c, j, off) = (0.45, 0.012, 0.008, -0.003);
+        let bobs = [0.1025, 0.0504];
+        let mut rows = Vec::new();
+        for (r, bob) in bobs.iter().enumerate() {
+            for i in 0..200 {
+                let u = (i * 13 + r * 7) as f64;
+                let mut x = vec![0.0; DELAY + 1];
+                x[0] = (u * 0.37).sin() * 3.0;
+                x[4] = (u * 0.11).cos().signum() / (1.3 - 0.6 * r as f64);
+                x[INERTIA] = (u * 0.23).sin() / bob;
+                x[OFFSET] = (u * 0.19).cos();
+                let dynamics = b * x[0] + t_c * x[4] + j * x[INERTIA];
+                let target = dynamics / (1.0 + j / bob) + off * x[OFFSET];
+                rows.push(row(r, *bob, x, target));
+            }
+        }
+        let cols = [0, 4, INERTIA, OFFSET];
+        let fit = ols(&rows, &cols).unwrap();
+        for (col, truth) in [(0, b), (4, t_c), (INERTIA, j), (OFFSET, off)] {
+            let (v, se) = fit.coef_of(col).unwrap();
+            assert!(
+                (v - truth).abs() < 1e-9 * truth.abs(),
+                "column {col}: {v} vs {truth}"
+            );
+            assert!(se.is_finite());
+        }
+        assert!(fit.rss < 1e-20, "rss {}", fit.rss);
+        // Without the per-run divisor (one linear fit) the same rows leave a misfit.
+        let plain = ols_at(&rows, &cols, 0.0).unwrap();
+        assert!(plain.rss > 1e-8, "rss {}", plain.rss);
     }
 }

@@ -15,7 +15,9 @@ use pendulum_model::excitation::{crank_f1, crank_f2};
 use pendulum_process::{Alignment, RunData};
 use serde::{Deserialize, Serialize};
 
-/// Regressors (each ∫K·term over a window), in dimensionless units of θ̈.
+/// Regressors (each ∫K·term over a window, in dimensionless units of θ̈ of the row's own run),
+/// each multiplied by its run's [`si_factors`] so that its coefficient is the SI parameter of
+/// effects.md, the same for every run of a campaign that mixes bobs and cranks.
 pub const TERMS: [&str; 16] = [
     "lin",       // θ̇
     "quad",      // θ̇|θ̇|
@@ -35,11 +37,47 @@ pub const TERMS: [&str; 16] = [
     "offset",  // (1 + A_y) cos θ
 ];
 
+/// Index of the extra-inertia regressor −(1 + A_y) sin θ / (m l²) in [`WeakRow::x`].
+pub const INERTIA: usize = 14;
+
 /// Index of the encoder-offset regressor (1 + A_y) cos θ in [`WeakRow::x`].
 pub const OFFSET: usize = 15;
 
 /// Index of the accel-delay regressor in [`WeakRow::x`] (after [`TERMS`]).
 pub const DELAY: usize = TERMS.len();
+
+/// Whether a column is a term of the equation of motion (damping, torques, tilt, inertia), as
+/// opposed to a sensor term (encoder offset, accelerometer lag, per-run zeroing errors). With
+/// extra inertia, (1 + j)θ̈ = −G − D: the dynamics reach the target divided by 1 + j_r, the
+/// sensor terms (errors of the measured θ and A_y that the target is computed from) do not.
+pub fn is_dynamics(col: usize) -> bool {
+    col < OFFSET
+}
+
+/// Per-run factors from the SI parameters of effects.md to the dimensionless coefficients of the
+/// run's own equation (`Physical::to_dimensionless`): β = b/(m ω0), α = a l/m, M = μ r_b/l,
+/// c = T_c/(m g l), p = T_p/(m g l), tan δ, j = J/(m l²), −θ_off, Δ ω0. A column multiplied by its
+/// factor has the SI parameter as its coefficient, so runs with different bobs, rods and cranks
+/// share one regression: pooling dimensionless columns would ask a light and a heavy bob for
+/// the same β and c, and their difference leaked into other columns (a 2 ms "accelerometer lag"
+/// on ideal data).
+pub fn si_factors(rig: &pendulum_process::RigParams) -> [f64; TERMS.len() + 1] {
+    let w0 = rig.omega0_rad_s();
+    let (m, l) = (rig.m_kg, rig.l_m);
+    let torque = 1.0 / (m * rig.g_m_s2 * l);
+    let mut f = [1.0; TERMS.len() + 1];
+    f[0] = 1.0 / (m * w0);
+    f[1] = l / m;
+    f[2] = rig.r_b_m / l;
+    f[3] = rig.r_b_m / l;
+    f[4] = torque;
+    for v in &mut f[5..13] {
+        *v = torque;
+    }
+    f[INERTIA] = 1.0 / (m * l * l);
+    f[DELAY] = w0;
+    f
+}
 
 /// One window.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -62,6 +100,13 @@ pub struct WeakRow {
     /// [`set_weights`] is called).
     #[serde(default = "one")]
     pub weight: f64,
+    /// The run's bob inertia m l², kg·m²: extra inertia J divides its dynamics by 1 + J/(m l²).
+    #[serde(default = "nan")]
+    pub bob_inertia_kg_m2: f64,
+}
+
+fn nan() -> f64 {
+    f64::NAN
 }
 
 fn one() -> f64 {
@@ -225,6 +270,7 @@ pub fn weak_rows(run_idx: usize, run: &RunData, al: &Alignment, cfg: &WeakConfig
     // dω/dt, dimensionless (zero unless the run was re-aligned on a drifting speed).
     let omega_dot = 2.0 * std::f64::consts::PI * al.speed_drift_hz_per_s / (w0 * w0);
     let r_over_l = run.rig.crank_r_m / run.rig.l_m;
+    let factors = si_factors(&run.rig);
     // Forcing in the aligned dimensionless time (φ = ωt + ½ω̇t²), and its rate.
     let ay_at = |tt: f64| -> (f64, f64) {
         let phi = omega * tt + 0.5 * omega_dot * tt * tt;
@@ -358,6 +404,9 @@ pub fn weak_rows(run_idx: usize, run: &RunData, al: &Alignment, cfg: &WeakConfig
                 (0.0, 0.0, f64::NAN)
             };
             let ta = al.t0_s + tau_c;
+            for (xi, f) in x.iter_mut().zip(factors) {
+                *xi *= f;
+            }
             let ia = run
                 .acc_t_s
                 .partition_point(|&v| v < ta)
@@ -376,6 +425,7 @@ pub fn weak_rows(run_idx: usize, run: &RunData, al: &Alignment, cfg: &WeakConfig
                 target,
                 x,
                 weight: 1.0,
+                bob_inertia_kg_m2: run.rig.m_kg * run.rig.l_m * run.rig.l_m,
             });
             c += 2 * half;
         }
@@ -420,7 +470,7 @@ mod tests {
         let run = RunData {
             id: "x".into(),
             role: Role::Identify,
-            rig,
+            rig: rig.clone(),
             enc_t_s: tr.t.iter().map(|t| t / w0).collect(),
             theta_rad: tr.theta.clone(),
             acc_t_s: vec![],
@@ -450,13 +500,22 @@ mod tests {
             };
             let rows = weak_rows(0, &run, &al, &cfg);
             assert!(rows.len() > 30, "h = {hw}: {} rows", rows.len());
-            let fit = crate::screen::ols(&rows, &[0, 2, 14]).unwrap();
+            // The coefficients are SI: b = β m ω0, μ = M l/r_b, J = j m l².
+            let fit = crate::screen::ols(&rows, &[0, 2, INERTIA]).unwrap();
             let (b, _) = fit.coef_of(0).unwrap();
-            let (mm, _) = fit.coef_of(2).unwrap();
-            let (j, _) = fit.coef_of(14).unwrap();
-            assert!((b - 0.05).abs() < 0.002, "h = {hw}: beta {b}");
-            assert!((mm - 0.007).abs() < 0.0005, "h = {hw}: M {mm}");
-            assert!(j.abs() < 0.01, "h = {hw}: j {j}");
+            let (mu, _) = fit.coef_of(2).unwrap();
+            let (j, _) = fit.coef_of(INERTIA).unwrap();
+            let (b_true, mu_true) = (0.05 * rig.m_kg * w0, 0.007 * rig.l_m / rig.r_b_m);
+            assert!(
+                (b / b_true - 1.0).abs() < 0.04,
+                "h = {hw}: b {b} vs {b_true}"
+            );
+            assert!(
+                (mu / mu_true - 1.0).abs() < 0.07,
+                "h = {hw}: mu {mu} vs {mu_true}"
+            );
+            let bob = rig.m_kg * rig.l_m * rig.l_m;
+            assert!(j.abs() < 0.01 * bob, "h = {hw}: J {j}");
         }
     }
 }
@@ -479,6 +538,7 @@ mod contrast_tests {
             target,
             x,
             weight: 1.0,
+            bob_inertia_kg_m2: 0.1,
         }
     }
 
