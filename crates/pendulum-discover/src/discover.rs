@@ -105,6 +105,10 @@ pub struct DiagnosisRow {
     pub heldout_eq_gain: f64,
     /// The screen's own estimate (equation error), SI.
     pub screen_estimate: f64,
+    /// The trajectory refit's estimate of the same parameter (output error on the identify
+    /// runs), SI; NaN when not refitted. An effect is accepted only when the two agree
+    /// ([`views_agree`]).
+    pub refit_estimate: f64,
     pub e_validate_before: f64,
     pub e_validate_after: f64,
     pub note: String,
@@ -347,6 +351,38 @@ fn practically_significant(effect: &str, estimate: f64) -> bool {
     }
 }
 
+/// Whether an estimate is in its effect's physical range: every dissipative term (b, a, μ, the
+/// bearing load's μ, T_c) takes energy out, so it cannot be negative (a negative dry torque
+/// feeds energy in), and an inertia cannot be negative. Outside it the screen has found a
+/// departure that the effect does not describe.
+pub fn physically_possible(effect: &str, estimate: f64) -> bool {
+    match effect {
+        "viscous_linear"
+        | "viscous_quadratic"
+        | "coulomb_bearing"
+        | "bearing_load_base_accel"
+        | "coulomb_constant"
+        | "extra_inertia" => estimate > 0.0,
+        "encoder_offset" => estimate.abs() < std::f64::consts::PI,
+        _ => estimate.is_finite(),
+    }
+}
+
+/// Relative accuracy the product promises for an estimate; the two views of an effect must agree
+/// at least this well.
+pub const AGREEMENT_REL: f64 = 0.10;
+
+/// Whether the screen (equation error) and the trajectory refit (output error) agree on an
+/// effect's size: the refit's value lies within the screen's 95 % interval or within
+/// [`AGREEMENT_REL`] of the screen's estimate, whichever is wider. (The refit is a local
+/// Nelder–Mead on E_θ without an interval of its own; 10 % is the accuracy claimed for any
+/// estimate.) Two independent views of the data that disagree on the sign or size of an effect
+/// have not found it: a 16 µs "accelerometer lag" the refit put at −47 µs was one.
+pub fn views_agree(screen: f64, half_width: f64, refit: f64) -> bool {
+    let band = half_width.max(AGREEMENT_REL * screen.abs());
+    refit.is_finite() && (refit - screen).abs() <= band
+}
+
 /// An accelerometer sensitivity error under 1 % is within a calibrated MPU-6050's tolerance and
 /// the crank fit's own systematic error (the sensor's 44 Hz low-pass alone scales the
 /// fundamental by −0.06 %), not the effect `accel_gain`.
@@ -427,6 +463,7 @@ fn accel_gain_row(ctx: &Context, cfg: &DiscoverConfig) -> Option<DiagnosisRow> {
         heldout_noise: f64::NAN,
         heldout_eq_gain: f64::NAN,
         screen_estimate: est,
+        refit_estimate: f64::NAN,
         e_validate_before: before,
         e_validate_after: after,
         note: format!(
@@ -550,6 +587,7 @@ fn speed_drift_row(
         heldout_noise: f64::NAN,
         heldout_eq_gain: f64::NAN,
         screen_estimate: est,
+        refit_estimate: f64::NAN,
         e_validate_before: f64::NAN,
         e_validate_after: f64::NAN,
         note: format!("crank fits with a drifting speed on {n} identify runs; screened out"),
@@ -947,6 +985,9 @@ pub fn discover(
     let mut rows: Vec<DiagnosisRow> = Vec::new();
     let mut confirmed: Vec<(String, DiagnosisRow)> = Vec::new();
     let mut correction = Correction::default();
+    // Why the best remaining candidate was refused, when the screen saw a departure it could
+    // not honestly name (then the departure is reported as `unexplained`).
+    let mut refused: Option<String> = None;
     let mut next = screened.chosen.first().cloned();
     let mut round = 0;
     while let Some(sc) = next.take() {
@@ -1021,22 +1062,37 @@ pub fn discover(
         // study's setting the validate runs' segments scatter by ±10–20 %, more than a dry torque
         // that μ half absorbs moves them, while their equation error tells the models apart.
         let held_out = gain > gain_needed || (eq_gain > eq_needed && gain > -noise);
-        let accepted = excludes_zero
-            && practically_significant(&c.effect, est)
-            && sc.delta_bic < cfg.screen_threshold
-            && held_out;
         // The refitted value of the effect's first parameter (μ for bearing_load_base_accel).
         let refit_est = match c.effect.as_str() {
             "bearing_load_base_accel" => spec
                 .params
                 .iter()
                 .position(|p| *p == FitParam::Mu)
-                .map_or(est, |i| x[i]),
+                .map_or(f64::NAN, |i| x[i]),
             _ => news
                 .first()
                 .and_then(|(p, _)| spec.params.iter().position(|q| q == p))
-                .map_or(est, |i| x[i]),
+                .map_or(f64::NAN, |i| x[i]),
         };
+        let possible = physically_possible(&c.effect, est);
+        let agree = views_agree(est, 1.96 * se, refit_est);
+        let accepted = excludes_zero
+            && practically_significant(&c.effect, est)
+            && sc.delta_bic < cfg.screen_threshold
+            && held_out
+            && possible
+            && agree;
+        // A clear departure that the best candidate fits only with an impossible value is real
+        // and unnamed. (A candidate the refit merely does not confirm is weak evidence, not a
+        // departure: it is refused in its row.)
+        if excludes_zero && sc.delta_bic < cfg.screen_threshold && !possible {
+            refused = Some(format!(
+                "the best catalogue candidate, {} (ΔBIC {:.1}), fits the departure only with a \
+                 physically impossible value: screen {est:.4e} {unit} [{:.4e}, {:.4e}], \
+                 trajectory refit {refit_est:.4e} {unit}",
+                c.effect, sc.delta_bic, ci.0, ci.1,
+            ));
+        }
         let row = DiagnosisRow {
             effect: c.effect.clone(),
             accepted,
@@ -1051,10 +1107,11 @@ pub fn discover(
             heldout_noise: noise,
             heldout_eq_gain: eq_gain,
             screen_estimate: est,
+        refit_estimate: f64::NAN,
             e_validate_before: before,
             e_validate_after: after,
             note: format!(
-                "{}{}; trajectory refit {:.4e} {}; held-out equation-error fall {:.1} % (needed > {:.1} %); refit f_obj {:.4}; E_θ gain needed > {:.3} (held-out noise {:.3})",
+                "{}{}{}; trajectory refit {:.4e} {}; held-out equation-error fall {:.1} % (needed > {:.1} %); refit f_obj {:.4}; E_θ gain needed > {:.3} (held-out noise {:.3})",
                 if c.effect == "position_torque" {
                     format!("k = {}; ", c.k)
                 } else {
@@ -1064,6 +1121,13 @@ pub fn discover(
                     "interval excludes 0"
                 } else {
                     "interval includes 0"
+                },
+                if !possible {
+                    "; outside its physical range: not accepted"
+                } else if !agree {
+                    "; the trajectory refit disagrees with the screen: not accepted"
+                } else {
+                    ""
                 },
                 refit_est,
                 unit,
@@ -1163,6 +1227,7 @@ pub fn discover(
             heldout_noise: f64::NAN,
             heldout_eq_gain: f64::NAN,
             screen_estimate: est,
+        refit_estimate: f64::NAN,
             e_validate_before: f64::NAN,
             e_validate_after: f64::NAN,
             note: if sc.candidate.effect == "position_torque" {
@@ -1211,9 +1276,14 @@ pub fn discover(
             }
         }
     }
-    let unexplained = worst.map(|(name, f, p)| {
+    let structure = worst.map(|(name, f, p)| {
         format!("the remaining equation error varies with {name} (F = {f:.1}, p = {p:.1e} over 12 bins)")
     });
+    let unexplained = match (refused, structure) {
+        (Some(r), Some(s)) => Some(format!("{r}; {s}")),
+        (Some(r), None) => Some(r),
+        (None, s) => s,
+    };
     if let Some(w) = &unexplained {
         rows.push(DiagnosisRow {
             effect: "unexplained".into(),
@@ -1227,6 +1297,7 @@ pub fn discover(
             heldout_noise: f64::NAN,
             heldout_eq_gain: f64::NAN,
             screen_estimate: f64::NAN,
+            refit_estimate: f64::NAN,
             e_validate_before: f64::NAN,
             e_validate_after: f64::NAN,
             note: w.clone(),

@@ -92,11 +92,12 @@ pub fn diagnosis_table(d: &Discovery) -> String {
     let mut t = String::new();
     let _ = writeln!(
         t,
-        "{:<24} {:>8} {:>12} {:>24} {:<6} {:>9} {:>16} {:>8}",
+        "{:<24} {:>8} {:>12} {:>24} {:>11} {:<6} {:>9} {:>16} {:>8}",
         "effect",
         "accepted",
         "estimate",
         "95 % interval",
+        "refit",
         "unit",
         "ΔBIC",
         "E_θ gain ± noise",
@@ -105,12 +106,17 @@ pub fn diagnosis_table(d: &Discovery) -> String {
     for r in &d.rows {
         let _ = writeln!(
             t,
-            "{:<24} {:>8} {:>12.4e} [{:>10.3e}, {:>10.3e}] {:<6} {:>9.1} {:>8} ±{:>6} {:>8}",
+            "{:<24} {:>8} {:>12.4e} [{:>10.3e}, {:>10.3e}] {:>11} {:<6} {:>9.1} {:>8} ±{:>6} {:>8}",
             r.effect,
             if r.accepted { "YES" } else { "no" },
             r.estimate,
             r.ci_low,
             r.ci_high,
+            if r.refit_estimate.is_finite() {
+                format!("{:.3e}", r.refit_estimate)
+            } else {
+                "-".into()
+            },
             r.unit,
             r.delta_bic,
             pct(r.heldout_gain),
@@ -252,6 +258,11 @@ pub fn run(job: &DiscoverJob) -> Result<DiscoverSummary, JobError> {
                 rows.iter().map(|r| r.screen_estimate).collect(),
                 "screen_estimate",
                 "see column unit",
+            ),
+            f(
+                rows.iter().map(|r| r.refit_estimate).collect(),
+                "refit_estimate",
+                "see column unit (NaN: not refitted)",
             ),
             f(
                 rows.iter().map(|r| r.e_validate_before).collect(),
@@ -799,7 +810,7 @@ fn write_report(
     for (p, v) in d.base.spec.params.iter().zip(&d.base.params) {
         let _ = writeln!(r, "- {} = {:.5} {}", p.name(), v, p.unit());
     }
-    let _ = writeln!(r, "\n## Diagnosis\n\nOne row per catalogue candidate screened (ΔBIC of the weak-form equation error on the identify runs); the best are refitted on the trajectories and accepted only if their 95 % interval excludes zero and the error on the validate runs, which neither the screen nor the refit saw, falls by more than chance explains: E_θ by more than max(2 %, its noise), or the equation error by more than max(5 %, its noise) while E_θ does not rise by more than its noise. A fall's noise is 1.96 × its standard error from the paired differences of the validate runs' 0.5 s shooting segments (E_θ) or weak-form windows (equation error); `gain ± noise` and `eq gain` in the table.\n\n```\n{table}```\n");
+    let _ = writeln!(r, "\n## Diagnosis\n\nOne row per catalogue candidate screened (ΔBIC of the weak-form equation error on the identify runs); the best are refitted on the trajectories and accepted only if their 95 % interval excludes zero and the error on the validate runs, which neither the screen nor the refit saw, falls by more than chance explains: E_θ by more than max(2 %, its noise), or the equation error by more than max(5 %, its noise) while E_θ does not rise by more than its noise. A fall's noise is 1.96 × its standard error from the paired differences of the validate runs' 0.5 s shooting segments (E_θ) or weak-form windows (equation error); `gain ± noise` and `eq gain` in the table. Two more conditions: the estimate is physically possible (no negative damping, dry torque or inertia), and the trajectory refit (`refit`) agrees with the screen's estimate, within its interval or 10 %, whichever is wider.\n\n```\n{table}```\n");
     match &d.unexplained {
         Some(u) => {
             let _ = writeln!(r, "**Unexplained:** {u}.\n");
