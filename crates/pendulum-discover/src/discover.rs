@@ -131,6 +131,10 @@ pub struct Discovery {
     pub validation_final: Vec<RunFit>,
     /// Where unexplained structure lives, if any.
     pub unexplained: Option<String>,
+    /// Shaker runs whose accelerometer the crank-rod model does not explain (tracked residual
+    /// over [`pendulum_process::align::FORCING_MISFIT_RATIO`] × the sensor's noise): their
+    /// forced segments and crank fits were left out, with the residual and the noise, m/s².
+    pub forcing_not_understood: Vec<(String, f64, f64)>,
 }
 
 impl Discovery {
@@ -183,7 +187,7 @@ impl View {
             };
             let mut al = al.clone();
             al.t0_s -= correction.delay_s;
-            let rows = if correction.theta_off_rad != 0.0 {
+            let mut rows = if correction.theta_off_rad != 0.0 {
                 let mut r2 = run.clone();
                 r2.theta_rad
                     .iter_mut()
@@ -192,6 +196,11 @@ impl View {
             } else {
                 weak_rows(i, run, &al, cfg)
             };
+            // A run whose accelerometer the crank-rod model does not explain gives no forcing
+            // to trust: only its free segment is used.
+            if !al.forcing_understood() {
+                rows.retain(|r| r.phase.is_nan());
+            }
             for mut r in rows {
                 r.run = weak_runs.len();
                 weak.push(r);
@@ -428,7 +437,7 @@ fn accel_gain_row(ctx: &Context, cfg: &DiscoverConfig) -> Option<DiagnosisRow> {
             .iter()
             .filter(|r| r.role == role)
             .filter_map(|r| ctx.alignments.get(&r.id))
-            .filter(|a| !a.is_free() && a.accel_gain.is_finite())
+            .filter(|a| !a.is_free() && a.accel_gain.is_finite() && a.forcing_understood())
             .map(|a| a.accel_gain)
             .collect()
     };
@@ -503,6 +512,7 @@ fn drift_evidence(ctx: &Context, cfg: &DiscoverConfig) -> Option<DriftEvidence> 
         if let Some(f) = ctx
             .alignments
             .get(&run.id)
+            .filter(|al| al.forcing_understood())
             .and_then(|al| fit_speed_drift(run, al))
         {
             fits.insert(run.id.clone(), f);
@@ -619,7 +629,9 @@ fn speed_drift_row(
     let (before, after) = (e_total(&val_b), e_total(&val));
     let (gain, noise) = heldout_gain(&val_b, &val);
     let gain_needed = cfg.gain_min.max(noise);
-    row.accepted = gain > gain_needed;
+    let refit_est = x.last().copied().unwrap_or(f64::NAN);
+    row.refit_estimate = refit_est;
+    row.accepted = gain > gain_needed && views_agree(est, half, refit_est);
     row.heldout_gain = gain;
     row.heldout_noise = noise;
     row.e_validate_before = before;
@@ -1335,6 +1347,20 @@ pub fn discover(
         residual_base,
         residual_final,
         unexplained,
+        forcing_not_understood: ctx
+            .runs
+            .iter()
+            .filter_map(|r| {
+                let a = ctx.alignments.get(&r.id)?;
+                (!a.forcing_understood()).then(|| {
+                    (
+                        r.id.clone(),
+                        a.forcing_residual_rms_m_s2,
+                        a.accel_noise_m_s2,
+                    )
+                })
+            })
+            .collect(),
     })
 }
 

@@ -491,6 +491,8 @@ mod tests {
             residual_rms_m_s2: 0.0,
             fit_window_s: (0.0, 0.0),
             speed_drift_hz_per_s: 0.0,
+            accel_noise_m_s2: f64::NAN,
+            forcing_residual_rms_m_s2: f64::NAN,
         };
         // The old default half-width and the current one.
         for hw in [0.08, 0.16] {

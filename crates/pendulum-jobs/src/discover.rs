@@ -366,6 +366,12 @@ pub fn run(job: &DiscoverJob) -> Result<DiscoverSummary, JobError> {
     if let Some(u) = &d.unexplained {
         let _ = writeln!(text, "unexplained: {u}");
     }
+    for (id, res, noise) in &d.forcing_not_understood {
+        let _ = writeln!(
+            text,
+            "forcing not understood in run {id}: the crank-rod model leaves {res:.3} m/s² RMS on the accelerometer (its noise: {noise:.3} m/s²); its forced segment and crank fit were left out"
+        );
+    }
     let fits: Vec<&pendulum_explain::EnvelopeFit> =
         envs.iter().filter_map(|e| e.env.as_ref().ok()).collect();
     let pooled = pooled_envelope(&fits);
@@ -534,6 +540,7 @@ fn free_decays(
             validation_base: Vec::new(),
             validation_final: Vec::new(),
             unexplained: None,
+            forcing_not_understood: Vec::new(),
         },
         decays,
         envelopes: Vec::new(),
@@ -811,6 +818,16 @@ fn write_report(
         let _ = writeln!(r, "- {} = {:.5} {}", p.name(), v, p.unit());
     }
     let _ = writeln!(r, "\n## Diagnosis\n\nOne row per catalogue candidate screened (ΔBIC of the weak-form equation error on the identify runs); the best are refitted on the trajectories and accepted only if their 95 % interval excludes zero and the error on the validate runs, which neither the screen nor the refit saw, falls by more than chance explains: E_θ by more than max(2 %, its noise), or the equation error by more than max(5 %, its noise) while E_θ does not rise by more than its noise. A fall's noise is 1.96 × its standard error from the paired differences of the validate runs' 0.5 s shooting segments (E_θ) or weak-form windows (equation error); `gain ± noise` and `eq gain` in the table. Two more conditions: the estimate is physically possible (no negative damping, dry torque or inertia), and the trajectory refit (`refit`) agrees with the screen's estimate, within its interval or 10 %, whichever is wider.\n\n```\n{table}```\n");
+    if !d.forcing_not_understood.is_empty() {
+        let _ = writeln!(r, "**Forcing not understood.** The crank-rod model, with the crank phase tracked turn by turn, does not explain the accelerometer of these runs (residual over {} × the sensor's own noise, measured while the shaker was off); their forced segments were left out of the equation-error view and their crank fits out of the sensor and drive effects (`forcing_understood` in `runs.parquet`):\n", pendulum_process::align::FORCING_MISFIT_RATIO);
+        for (id, res, noise) in &d.forcing_not_understood {
+            let _ = writeln!(
+                r,
+                "- `{id}`: residual {res:.3} m/s² RMS, noise {noise:.3} m/s²"
+            );
+        }
+        let _ = writeln!(r);
+    }
     match &d.unexplained {
         Some(u) => {
             let _ = writeln!(r, "**Unexplained:** {u}.\n");

@@ -399,7 +399,7 @@ pub fn write_outputs(
                     .collect()
             })
             .unwrap_or_default();
-        let mut c: Vec<Vec<f64>> = vec![Vec::new(); 15];
+        let mut c: Vec<Vec<f64>> = vec![Vec::new(); 17];
         let mut kinds = Vec::new();
         let (mut ids, mut roles, mut meas, mut sim, mut agree) =
             (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
@@ -434,6 +434,8 @@ pub fn write_outputs(
                     .find(|f| f.id == r.id)
                     .map_or(f64::NAN, |f| f.e_theta),
                 al.map_or(f64::NAN, |a| a.omega0_est_rad_s),
+                al.map_or(f64::NAN, |a| a.accel_noise_m_s2),
+                al.map_or(f64::NAN, |a| a.forcing_residual_rms_m_s2),
             ];
             for (col, v) in c.iter_mut().zip(vals) {
                 col.push(v);
@@ -463,6 +465,8 @@ pub fn write_outputs(
             ("hanging_theta", "rad"),
             ("e_theta", "rad"),
             ("omega0_est_rad_s", "rad/s"),
+            ("accel_noise_m_s2", "m/s²"),
+            ("forcing_residual_rms_m_s2", "m/s²"),
         ];
         let mut cols = vec![
             strs("run_id", ids),
@@ -477,6 +481,21 @@ pub fn write_outputs(
         cols.push(strs("simulated_steady", sim));
         cols.push(ints("simulated_period", sim_p));
         cols.push(Column::new("steady_agrees", ColumnData::Bool(agree)));
+        // The crank-rod model explains the accelerometer along the whole forced segment
+        // (tracked residual within a few times the sensor's noise).
+        cols.push(Column::new(
+            "forcing_understood",
+            ColumnData::Bool(
+                ctx.runs
+                    .iter()
+                    .map(|r| {
+                        ctx.alignments
+                            .get(&r.id)
+                            .is_none_or(|a| a.forcing_understood())
+                    })
+                    .collect(),
+            ),
+        ));
         let p = out.join("runs.parquet");
         opts.clone()
             .meta(

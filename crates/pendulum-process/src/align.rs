@@ -135,16 +135,37 @@ pub struct Alignment {
     /// ([`fit_speed_drift`]).
     #[serde(default)]
     pub speed_drift_hz_per_s: f64,
+    /// The accelerometer's own noise, m/s²: robust spread of the vertical signal while the
+    /// shaker is off (NaN for free decays).
+    #[serde(default = "nan")]
+    pub accel_noise_m_s2: f64,
+    /// RMS residual of the crank-rod model along the whole forced segment with the crank phase
+    /// tracked turn by turn ([`track_crank_phase`]), m/s² (NaN when not tracked).
+    #[serde(default = "nan")]
+    pub forcing_residual_rms_m_s2: f64,
 }
 
 fn nan() -> f64 {
     f64::NAN
 }
 
+/// How far above the accelerometer's own noise the crank-rod model's residual may be before the
+/// forcing counts as not understood: the model is exact for a rigid crank and rod, so with the
+/// phase tracked its residual is the sensor noise; three times it (nine times its variance) is
+/// a shape the model does not have.
+pub const FORCING_MISFIT_RATIO: f64 = 3.0;
+
 impl Alignment {
     /// A free decay (excitation off).
     pub fn is_free(&self) -> bool {
         self.kind == AlignmentKind::FreeDecay
+    }
+
+    /// Whether the crank-rod model explains the accelerometer along the whole forced segment
+    /// (tracked residual within [`FORCING_MISFIT_RATIO`] of the sensor's noise). Free decays and
+    /// runs that could not be tracked count as understood: there is nothing to contradict.
+    pub fn forcing_understood(&self) -> bool {
+        !(self.forcing_residual_rms_m_s2 > FORCING_MISFIT_RATIO * self.accel_noise_m_s2)
     }
 
     /// The encoder samples of `run` inside the free-motion segment before the shaker, when the
@@ -197,6 +218,8 @@ pub fn align_free_decay(run: &RunData) -> Result<Alignment, ProcessError> {
         residual_rms_m_s2: f64::NAN,
         fit_window_s: (f64::NAN, f64::NAN),
         speed_drift_hz_per_s: 0.0,
+        accel_noise_m_s2: f64::NAN,
+        forcing_residual_rms_m_s2: f64::NAN,
     })
 }
 
@@ -411,7 +434,7 @@ pub fn align(run: &RunData, cfg: &AlignConfig) -> Result<Alignment, ProcessError
     // t0 = t_p + k/Ω: propagate the covariance of (Ω, t_p).
     let d_om = -k / (omega * omega);
     let var = cov[3 * 4 + 3] + d_om * d_om * cov[2 * 4 + 2] + 2.0 * d_om * cov[2 * 4 + 3];
-    Ok(Alignment {
+    let mut al = Alignment {
         kind: AlignmentKind::Shaker,
         omega0_est_rad_s: f64::NAN,
         shaker_start_s,
@@ -425,7 +448,171 @@ pub fn align(run: &RunData, cfg: &AlignConfig) -> Result<Alignment, ProcessError
         residual_rms_m_s2: rms,
         fit_window_s: (w_start, w_end),
         speed_drift_hz_per_s: 0.0,
-    })
+        accel_noise_m_s2: sigma_q,
+        forcing_residual_rms_m_s2: f64::NAN,
+    };
+    if let Some(track) = track_crank_phase(run, &al) {
+        al.forcing_residual_rms_m_s2 = track.residual_rms_m_s2;
+    }
+    Ok(al)
+}
+
+/// The crank phase followed turn by turn along a run's forced segment.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PhaseTrack {
+    /// Block centres, s from the alignment's t0.
+    pub tau_s: Vec<f64>,
+    /// Crank phase at each centre (unwrapped, 0 at t0 for the alignment's own phase), rad, and
+    /// its standard uncertainty.
+    pub phase_rad: Vec<f64>,
+    pub phase_sigma_rad: Vec<f64>,
+    /// RMS of the crank-rod model's residual over every tracked block, m/s².
+    pub residual_rms_m_s2: f64,
+}
+
+impl PhaseTrack {
+    /// Weighted least-squares quadratic φ(τ) = a0 + a1 τ + a2 τ² through the track: Ω at t0 is
+    /// a1/2π and dΩ/dτ is a2/π. Returns (a0, a1, a2) and the covariance's diagonal, the latter
+    /// scaled by the fit's reduced χ² when that exceeds 1 (a speed that wanders more than the
+    /// track's own scatter says widens the interval rather than hiding in it).
+    pub fn quadratic(&self) -> Option<([f64; 3], [f64; 3])> {
+        let n = self.tau_s.len();
+        if n < 6 {
+            return None;
+        }
+        let mut ata = [0.0; 9];
+        let mut atb = [0.0; 3];
+        for i in 0..n {
+            let w = 1.0 / self.phase_sigma_rad[i].powi(2).max(1e-300);
+            let x = [1.0, self.tau_s[i], self.tau_s[i] * self.tau_s[i]];
+            for a in 0..3 {
+                atb[a] += w * x[a] * self.phase_rad[i];
+                for b in 0..3 {
+                    ata[a * 3 + b] += w * x[a] * x[b];
+                }
+            }
+        }
+        let c = solve(&ata, &atb, 3)?;
+        let inv = inverse(&ata, 3)?;
+        let chi2: f64 = (0..n)
+            .map(|i| {
+                let tau = self.tau_s[i];
+                let e = self.phase_rad[i] - (c[0] + c[1] * tau + c[2] * tau * tau);
+                (e / self.phase_sigma_rad[i]).powi(2)
+            })
+            .sum();
+        let red = (chi2 / (n as f64 - 3.0)).max(1.0);
+        Some((
+            [c[0], c[1], c[2]],
+            [inv[0] * red, inv[4] * red, inv[8] * red],
+        ))
+    }
+}
+
+/// Follows the crank phase from t0 to the end of the capture in blocks of two crank turns: in
+/// each, Gauss–Newton on a local phase and speed (offset and gain from the alignment), started
+/// from the previous block's phase and speed carried forward, so the phase never has to be
+/// found across more than a fraction of a turn. A drifting motor, which puts a constant-speed
+/// model tens of radians off by the end of a run (and a linear-drift fit started from zero
+/// drift out of reach), is then just a slowly bending track. Stops at a block it cannot lock
+/// onto (a gap, the shaker stopping). `None` for free decays or fewer than six blocks.
+pub fn track_crank_phase(run: &RunData, al: &Alignment) -> Option<PhaseTrack> {
+    if al.is_free() || !(al.omega_hz > 0.0) {
+        return None;
+    }
+    let (t, az) = (&run.acc_t_s, &run.az_m_s2);
+    let r = run.rig.crank_r_m;
+    let lambda = r / run.rig.rod_l_m;
+    let two_pi = 2.0 * std::f64::consts::PI;
+    let (c0, g) = (al.az_offset_m_s2, al.accel_gain);
+    let mut omega = two_pi * al.omega_hz; // rad/s
+    let mut period = 1.0 / al.omega_hz;
+    // The phase at t0 is 0 by the alignment's definition; the first block starts there.
+    let (mut tc_prev, mut psi_prev) = (al.t0_s, 0.0);
+    let mut a = al.t0_s;
+    let t_end = *t.last()?;
+    let mut track = PhaseTrack {
+        tau_s: Vec::new(),
+        phase_rad: Vec::new(),
+        phase_sigma_rad: Vec::new(),
+        residual_rms_m_s2: f64::NAN,
+    };
+    let (mut ss_all, mut n_all) = (0.0, 0usize);
+    while a + 2.0 * period <= t_end {
+        let b = a + 2.0 * period;
+        let tc = 0.5 * (a + b);
+        let lo = t.partition_point(|&x| x < a);
+        let hi = t.partition_point(|&x| x < b);
+        // A block with a gap (fewer than 80 % of its samples) is stepped over on the prediction.
+        let expected = 2.0 * period / median_step(t).max(1e-9);
+        if ((hi - lo) as f64) < 0.8 * expected || hi - lo < 12 {
+            a = b;
+            continue;
+        }
+        let mut p = [psi_prev + omega * (tc - tc_prev), omega];
+        let model = |p: &[f64; 2], ti: f64| -> f64 {
+            let phi = p[0] + p[1] * (ti - tc);
+            c0 + g * r * p[1] * p[1] * crank_f2(phi, lambda)
+        };
+        let mut ok = false;
+        let mut cov00 = f64::NAN;
+        let mut ss = 0.0;
+        for _ in 0..8 {
+            let mut jtj = [0.0; 4];
+            let mut jtr = [0.0; 2];
+            ss = 0.0;
+            for i in lo..hi {
+                let phi = p[0] + p[1] * (t[i] - tc);
+                let res = az[i] - model(&p, t[i]);
+                ss += res * res;
+                let d_psi = g * r * p[1] * p[1] * f3(phi, lambda);
+                let d_om = d_psi * (t[i] - tc) + 2.0 * g * r * p[1] * crank_f2(phi, lambda);
+                let j = [d_psi, d_om];
+                for x in 0..2 {
+                    jtr[x] += j[x] * res;
+                    for y in 0..2 {
+                        jtj[x * 2 + y] += j[x] * j[y];
+                    }
+                }
+            }
+            let Some(d) = solve(&jtj, &jtr, 2) else { break };
+            let s2 = ss / ((hi - lo) as f64 - 2.0);
+            cov00 = inverse(&jtj, 2).map_or(f64::NAN, |inv| inv[0] * s2);
+            p[0] += d[0];
+            p[1] += d[1];
+            if d[0].abs() < 1e-9 && d[1].abs() < 1e-9 * p[1] {
+                ok = true;
+                break;
+            }
+        }
+        let predicted = psi_prev + omega * (tc - tc_prev);
+        // Lost lock: no convergence, or a jump of more than a quarter turn from the prediction.
+        if !ok || (p[0] - predicted).abs() > 0.25 * two_pi || !(p[1] > 0.0) {
+            break;
+        }
+        ss_all += ss;
+        n_all += hi - lo;
+        track.tau_s.push(tc - al.t0_s);
+        track.phase_rad.push(p[0]);
+        track.phase_sigma_rad.push(cov00.max(1e-12).sqrt());
+        (tc_prev, psi_prev, omega) = (tc, p[0], p[1]);
+        period = two_pi / omega;
+        a = b;
+    }
+    if track.tau_s.len() < 6 {
+        return None;
+    }
+    track.residual_rms_m_s2 = (ss_all / n_all as f64).sqrt();
+    Some(track)
+}
+
+fn median_step(t: &[f64]) -> f64 {
+    let mut d: Vec<f64> = t
+        .windows(2)
+        .map(|w| w[1] - w[0])
+        .filter(|d| *d > 0.0)
+        .collect();
+    median(&mut d)
 }
 
 /// A crank fit that lets the speed drift linearly (the effect `speed_drift`).
@@ -476,7 +663,18 @@ pub fn fit_speed_drift(run: &RunData, al: &Alignment) -> Option<DriftFit> {
             * r
             * (rate * rate * crank_f2(phi, lambda) + two_pi * p[3] * crank_f1(phi, lambda))
     };
+    // Start from the phase track's quadratic (Ω at t0, dΩ/dτ, the peak's shift): started from
+    // zero drift, Gauss–Newton cannot reach a drift whose phase error is many turns by the end.
     let mut p = [al.az_offset_m_s2, al.accel_gain, al.omega_hz, 0.0, 0.0];
+    if let Some(([a0, a1, a2], _)) = track_crank_phase(run, al).and_then(|tr| tr.quadratic()) {
+        // φ = 2πΩ0(τ − δ) + πΩ̇(τ − δ)² = a0 + a1 τ + a2 τ² to first order in δ.
+        let drift = a2 / std::f64::consts::PI;
+        let delta = -a0 / a1;
+        let om0 = (a1 + 2.0 * a2 * delta) / two_pi;
+        if drift.is_finite() && delta.is_finite() && om0 > 0.0 {
+            p = [al.az_offset_m_s2, al.accel_gain, om0, drift, delta];
+        }
+    }
     let steps = [1e-4, 1e-7, 1e-8, 1e-8, 1e-7];
     let mut cov = [0.0; 25];
     let mut rms = f64::NAN;
