@@ -382,14 +382,48 @@ pub fn physically_possible(effect: &str, estimate: f64) -> bool {
 pub const AGREEMENT_REL: f64 = 0.10;
 
 /// Whether the screen (equation error) and the trajectory refit (output error) agree on an
-/// effect's size: the refit's value lies within the screen's 95 % interval or within
-/// [`AGREEMENT_REL`] of the screen's estimate, whichever is wider. (The refit is a local
-/// Nelder–Mead on E_θ without an interval of its own; 10 % is the accuracy claimed for any
-/// estimate.) Two independent views of the data that disagree on the sign or size of an effect
-/// have not found it: a 16 µs "accelerometer lag" the refit put at −47 µs was one.
-pub fn views_agree(screen: f64, half_width: f64, refit: f64) -> bool {
+/// effect: the same sign, and each estimate inside the other's interval. The refit's value is
+/// inside the screen's when it lies within the screen's 95 % interval or within
+/// [`AGREEMENT_REL`] of its estimate, whichever is wider (10 % is the accuracy claimed for any
+/// estimate); the screen's value is inside the refit's when, put in the refit's place,
+/// it does not make the identify runs' trajectories significantly worse
+/// (`screen_fits_trajectories`, a paired test on their 0.5 s segments: trajectories often pin a
+/// dry torque's size poorly, trading it against μ). Two views that disagree on the sign have
+/// not found the effect: a 16 µs "accelerometer lag" the refit put at −47 µs was one.
+pub fn views_agree(
+    screen: f64,
+    half_width: f64,
+    refit: f64,
+    screen_fits_trajectories: bool,
+) -> bool {
+    if !(refit.is_finite() && refit * screen > 0.0) {
+        return false;
+    }
     let band = half_width.max(AGREEMENT_REL * screen.abs());
-    refit.is_finite() && (refit - screen).abs() <= band
+    (refit - screen).abs() <= band || screen_fits_trajectories
+}
+
+/// Paired comparison of two parameter vectors of one model on the identify runs' trajectories
+/// (initial states `ics`): the fractional fall of E_θ from `x` to `x_alt` over their 0.5 s
+/// segments and the noise it must beat (negative: `x_alt` is worse).
+fn trajectory_substitution(
+    runs: &[PreparedRun],
+    spec: &ModelSpec,
+    x: &[f64],
+    x_alt: &[f64],
+    ics: &[f64],
+) -> (f64, f64) {
+    let obj = refit_objective(runs, spec);
+    let segments = |p: &[f64]| -> Vec<f64> {
+        let mut full = p.to_vec();
+        full.extend_from_slice(ics);
+        obj.evaluate(&full).per_run_segment_e.concat()
+    };
+    let (a, b) = (segments(x), segments(x_alt));
+    if a.len() != b.len() {
+        return (f64::NEG_INFINITY, 0.0);
+    }
+    paired_gain(&a, &b)
 }
 
 /// An accelerometer sensitivity error under 1 % is within a calibrated MPU-6050's tolerance and
@@ -631,7 +665,15 @@ fn speed_drift_row(
     let gain_needed = cfg.gain_min.max(noise);
     let refit_est = x.last().copied().unwrap_or(f64::NAN);
     row.refit_estimate = refit_est;
-    row.accepted = gain > gain_needed && views_agree(est, half, refit_est);
+    let screen_fits = {
+        let mut xs = x.clone();
+        if let Some(v) = xs.last_mut() {
+            *v = est;
+        }
+        let (g, n) = trajectory_substitution(&id2, &spec, &x, &xs, &ics2);
+        g >= -n
+    };
+    row.accepted = gain > gain_needed && views_agree(est, half, refit_est, screen_fits);
     row.heldout_gain = gain;
     row.heldout_noise = noise;
     row.e_validate_before = before;
@@ -1087,7 +1129,21 @@ pub fn discover(
                 .map_or(f64::NAN, |i| x[i]),
         };
         let possible = physically_possible(&c.effect, est);
-        let agree = views_agree(est, 1.96 * se, refit_est);
+        // The refit's own interval: does the screen's value, put in its place, make the identify
+        // runs' trajectories significantly worse (paired 0.5 s segments)?
+        let refit_idx = match c.effect.as_str() {
+            "bearing_load_base_accel" => spec.params.iter().position(|p| *p == FitParam::Mu),
+            _ => news
+                .first()
+                .and_then(|(p, _)| spec.params.iter().position(|q| q == p)),
+        };
+        let screen_fits_trajectories = refit_idx.is_some_and(|i| {
+            let mut xs = x.clone();
+            xs[i] = est;
+            let (g, n) = trajectory_substitution(&id_runs, &spec, &x, &xs, &ics);
+            g >= -n
+        });
+        let agree = views_agree(est, 1.96 * se, refit_est, screen_fits_trajectories);
         let accepted = excludes_zero
             && practically_significant(&c.effect, est)
             && sc.delta_bic < cfg.screen_threshold
@@ -1119,7 +1175,7 @@ pub fn discover(
             heldout_noise: noise,
             heldout_eq_gain: eq_gain,
             screen_estimate: est,
-        refit_estimate: f64::NAN,
+            refit_estimate: refit_est,
             e_validate_before: before,
             e_validate_after: after,
             note: format!(

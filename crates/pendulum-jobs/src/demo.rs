@@ -119,29 +119,20 @@ pub fn campaign(
     })
 }
 
-/// An eight-run twin case (five identify, three validate runs; both capture formats; mixed
-/// steady states) on the study's rig with damping a, b, μ and `effects` (a TOML table body for
-/// `[truth.effects]`): the discovery campaign of the demo, the tests and the benchmark.
+/// A discovery campaign for the twin: five identify and three validate runs whose design is
+/// drawn per run from `seed` as rig.md allows ([`pendulum_rig::twin::draw_design`]: bob, length,
+/// crank, speed, format, hand start, durations), with damping a, b, μ and `effects` (lines of
+/// the case's `[truth.effects]` table) hidden in the captures.
 pub fn discovery_campaign(name: &str, seed: u64, a: f64, b: f64, mu: f64, effects: &str) -> String {
-    let runs = [
-        ("r01", 1.30, "identify", "serial", 0.8, 0.0),
-        ("r02", 1.54, "identify", "sd", 1.5, 0.0),
-        ("r03", 1.65, "identify", "serial", 0.5, 0.0),
-        ("r04", 1.75, "identify", "sd", 1.0, -9.0),
-        ("r05", 1.75, "identify", "serial", 0.5, 0.0),
-        ("v01", 1.54, "validate", "sd", 1.2, 0.0),
-        ("v02", 1.65, "validate", "serial", 1.5, 0.0),
-        ("v03", 1.30, "validate", "sd", 0.6, 3.0),
+    let roles = [
+        "identify", "identify", "identify", "identify", "identify", "validate", "validate",
+        "validate",
     ];
-    let mut s = format!(
-        "name = \"{name}\"\nseed = {seed}\n[rig]\nm_kg = 1.46\nl_m = 0.265\ncrank_r_m = 0.0725\nrod_L_m = 0.575\nr_b_m = 0.01225\n[truth]\na_kg_m = {a}\nb_n_s_m = {b}\nmu = {mu}\n[truth.effects]\n{effects}\n"
-    );
-    for (id, om, role, fmt, th, thd) in runs {
-        s += &format!(
-            "[[run]]\nid = \"{id}\"\nomega_hz = {om}\nrole = \"{role}\"\nformat = \"{fmt}\"\ntheta0_rad = {th}\ntheta_dot0_rad_s = {thd}\nfree_s = 4\nforced_s = 30\n"
-        );
-    }
-    s
+    let rod_l_m = 0.575;
+    format!(
+        "name = \"{name}\"\nseed = {seed}\n[rig]\nm_kg = 1.46\nl_m = 0.265\ncrank_r_m = 0.0725\nrod_L_m = {rod_l_m}\nr_b_m = 0.01225\n[truth]\na_kg_m = {a}\nb_n_s_m = {b}\nmu = {mu}\n[truth.effects]\n{effects}\n{}",
+        pendulum_rig::twin::draw_design(seed, &roles, rod_l_m)
+    )
 }
 
 /// The demo's discovery campaign: a guide tilted 0.04 rad from vertical (`horizontal_base`)

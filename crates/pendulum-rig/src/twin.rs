@@ -167,6 +167,23 @@ pub struct TwinRun {
     /// Crank radius for this run, m (the rig's when absent).
     #[serde(default)]
     pub crank_r_m: Option<f64>,
+    /// Bob mass and axis-to-centre-of-mass length for this run (the rig's when absent): rig.md
+    /// lets a campaign change bobs between runs.
+    #[serde(default)]
+    pub m_kg: Option<f64>,
+    #[serde(default)]
+    pub l_m: Option<f64>,
+}
+
+impl TwinRun {
+    /// The truth with this run's own bob and crank.
+    pub fn physical(&self, case: &TwinCase) -> Physical {
+        let mut phys = case.physical();
+        phys.crank_r_m = self.crank_r_m.unwrap_or(case.rig.crank_r_m);
+        phys.m_kg = self.m_kg.unwrap_or(case.rig.m_kg);
+        phys.l_m = self.l_m.unwrap_or(case.rig.l_m);
+        phys
+    }
 }
 
 /// Fraction of the set speed that counts as "at speed" for the truth's t = 0.
@@ -253,6 +270,16 @@ impl TwinCase {
                 key: "rig/truth".into(),
                 expected: e.to_string(),
             })?;
+        for run in &case.runs {
+            run.physical(&case)
+                .validate()
+                .map_err(|e| RigError::CampaignKey {
+                    path: path.to_path_buf(),
+                    run: Some(run.id.clone()),
+                    key: "m_kg/l_m/crank_r_m".into(),
+                    expected: e.to_string(),
+                })?;
+        }
         Ok(case)
     }
 
@@ -325,6 +352,14 @@ pub fn synthesize(case: &TwinCase, out_dir: &Path) -> Result<TwinSummary, RigErr
             run.omega_hz,
             run.role
         ));
+        // A run's own bob overrides the [rig] table's (rig.md: "shared by every run unless a
+        // run overrides a key").
+        if let Some(m) = run.m_kg {
+            text.push_str(&format!("m_kg = {m}\n"));
+        }
+        if let Some(l) = run.l_m {
+            text.push_str(&format!("l_m = {l}\n"));
+        }
     }
     write_atomic(&campaign_path, text.as_bytes())?;
     let truth = TwinTruthFile {
@@ -365,8 +400,7 @@ fn synthesize_run(
 ) -> Result<RunTruth, RigError> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let s = &case.sensors;
-    let mut phys = case.physical();
-    phys.crank_r_m = run.crank_r_m.unwrap_or(case.rig.crank_r_m);
+    let mut phys = run.physical(case);
     let speed_err = if s.speed_error_max > 0.0 {
         rng.random_range(-s.speed_error_max..=s.speed_error_max)
     } else {
@@ -747,4 +781,54 @@ fn synthesize_run(
         accel_samples: t_acc.len() as u64,
         damaged_pieces: damaged,
     })
+}
+
+/// Bob masses of rig.md, kg.
+pub const BOB_MASSES_KG: [f64; 2] = [0.745, 1.46];
+/// Axis-to-bob lengths rig.md allows, m.
+pub const BOB_LENGTH_RANGE_M: (f64, f64) = (0.17, 0.27);
+/// Crank radii of rig.md, m.
+pub const CRANK_RADII_M: [f64; 3] = [0.0725, 0.1065, 0.205];
+/// Crank speeds rig.md's motor covers, Hz.
+pub const CRANK_SPEED_RANGE_HZ: (f64, f64) = (0.87, 2.36);
+/// Largest peak base acceleration a drawn run may ask for, m/s²: the accelerometer's range is
+/// ±4 g and z reads 1 g at rest, so 2.5 g keeps the peaks on scale with a margin (a real
+/// experimenter does not saturate the sensor they align on).
+pub const MAX_BASE_ACCEL_M_S2: f64 = 2.5 * 9.81;
+
+/// Draws a campaign's runs as rig.md allows them, one design per run: bob (mass of rig.md,
+/// length in its range), crank radius, crank speed (peak base acceleration on the
+/// accelerometer's scale), capture format, hand start (angle and rate), free and forced
+/// durations. `roles` gives each run's role ("identify"/"validate"); ids are r01, r02, … .
+/// Returns the `[[run]]` tables of a twin case (TOML), every key explicit.
+pub fn draw_design(seed: u64, roles: &[&str], rod_l_m: f64) -> String {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0xD351_6E00_0000_0000);
+    let mut out = String::new();
+    for (i, role) in roles.iter().enumerate() {
+        let m = BOB_MASSES_KG[rng.random_range(0..BOB_MASSES_KG.len())];
+        let l = rng.random_range(BOB_LENGTH_RANGE_M.0..BOB_LENGTH_RANGE_M.1);
+        let (r, omega) = loop {
+            let r = CRANK_RADII_M[rng.random_range(0..CRANK_RADII_M.len())];
+            let om = rng.random_range(CRANK_SPEED_RANGE_HZ.0..CRANK_SPEED_RANGE_HZ.1);
+            let peak = r * (2.0 * std::f64::consts::PI * om).powi(2) * (1.0 + r / rod_l_m);
+            if peak <= MAX_BASE_ACCEL_M_S2 {
+                break (r, om);
+            }
+        };
+        let format = if rng.random::<bool>() { "serial" } else { "sd" };
+        // A hand start: a swing of up to 2.5 rad, or a spin.
+        let theta0 = rng.random_range(-2.5..2.5);
+        let theta_dot0 = if rng.random_range(0.0..1.0) < 0.25 {
+            rng.random_range(-10.0..10.0)
+        } else {
+            0.0
+        };
+        let free_s = rng.random_range(3.0..6.0);
+        let forced_s = rng.random_range(25.0..40.0);
+        out.push_str(&format!(
+            "[[run]]\nid = \"r{:02}\"\nrole = \"{role}\"\nformat = \"{format}\"\nm_kg = {m}\nl_m = {l:.4}\ncrank_r_m = {r}\nomega_hz = {omega:.3}\ntheta0_rad = {theta0:.3}\ntheta_dot0_rad_s = {theta_dot0:.3}\nfree_s = {free_s:.2}\nforced_s = {forced_s:.1}\n",
+            i + 1
+        ));
+    }
+    out
 }
