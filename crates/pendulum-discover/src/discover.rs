@@ -1050,8 +1050,43 @@ pub fn discover(
         let Some(fit) = ols(&view.id_rows, &cols) else {
             break;
         };
-        let (est, se, unit) = to_si(c, &fit);
-        let (spec, news) = extend(&current.spec, c, &fit);
+        let (mut est, se, unit) = to_si(c, &fit);
+        // An effect that enters nonlinearly (an encoder offset, an accelerometer lag) is applied
+        // exactly to the measured motion and its estimate refined there before it is judged:
+        // the regression's column has it only to first order (a 0.066 rad offset read 0.053).
+        let nonlinear = matches!(c.effect.as_str(), "encoder_offset" | "accel_delay");
+        let mut refined: Option<(View, Correction)> = None;
+        if nonlinear {
+            let set = |corr: &mut Correction, v: f64| match c.effect.as_str() {
+                "encoder_offset" => corr.theta_off_rad = v,
+                _ => corr.delay_s = v,
+            };
+            let mut corr = correction;
+            for _ in 0..3 {
+                set(&mut corr, est);
+                let v = View::build(ctx, &weak_ctx.alignments, base, &cfg.weak, corr);
+                let Some(f2) = ols(&v.id_rows, &cols) else {
+                    break;
+                };
+                // The corrected view's column holds what is left of the effect.
+                let (step, _, _) = to_si(c, &f2);
+                est += step;
+                if step.abs() < 1e-3 * est.abs() {
+                    break;
+                }
+            }
+            set(&mut corr, est);
+            refined = Some((
+                View::build(ctx, &weak_ctx.alignments, base, &cfg.weak, corr),
+                corr,
+            ));
+        }
+        let (spec, mut news) = extend(&current.spec, c, &fit);
+        if nonlinear {
+            if let Some(n) = news.first_mut() {
+                n.1 = est;
+            }
+        }
         let mut x0: Vec<f64> = spec
             .params
             .iter()
@@ -1208,36 +1243,11 @@ pub fn discover(
         };
         let mut row = row;
         if accepted {
-            // An effect that enters nonlinearly is applied exactly to the measured motion (and its
-            // estimate refined by re-estimating on the corrected view), so that its linearised
-            // remainder is not mistaken for a second effect or left as `unexplained`.
-            if matches!(c.effect.as_str(), "encoder_offset" | "accel_delay") {
-                for _ in 0..3 {
-                    match c.effect.as_str() {
-                        "encoder_offset" => correction.theta_off_rad = row.estimate,
-                        _ => correction.delay_s = row.estimate,
-                    }
-                    view = View::build(ctx, &weak_ctx.alignments, base, &cfg.weak, correction);
-                    let Some(f2) = ols(&view.id_rows, &cols) else {
-                        break;
-                    };
-                    // The corrected view's column holds what is left of the effect.
-                    let (step, _, _) = to_si(c, &f2);
-                    row.estimate += step;
-                    row.ci_low += step;
-                    row.ci_high += step;
-                    if step.abs() < 1e-3 * row.estimate.abs() {
-                        break;
-                    }
-                }
-                match c.effect.as_str() {
-                    "encoder_offset" => correction.theta_off_rad = row.estimate,
-                    _ => correction.delay_s = row.estimate,
-                }
-                view = View::build(ctx, &weak_ctx.alignments, base, &cfg.weak, correction);
+            if let Some((v, corr)) = refined {
+                view = v;
+                correction = corr;
                 row.note.push_str(&format!(
-                    "; applied exactly to the equation-error view (refined estimate {:.4e} {unit})",
-                    row.estimate
+                    "; applied exactly to the equation-error view (refined estimate {est:.4e} {unit})"
                 ));
             }
         }

@@ -54,6 +54,8 @@ pub struct DiscoverSummary {
     /// Per run of a shaker campaign, the envelope of its free segment before the shaker starts
     /// (or why it could not be read).
     pub envelopes: Vec<(String, Result<pendulum_explain::EnvelopeFit, String>)>,
+    /// The free segments' envelopes pooled over the runs ([`pooled_envelope`]), SI.
+    pub pooled: Vec<PooledTerm>,
     pub text: String,
 }
 
@@ -372,13 +374,12 @@ pub fn run(job: &DiscoverJob) -> Result<DiscoverSummary, JobError> {
             "forcing not understood in run {id}: the crank-rod model leaves {res:.3} m/s² RMS on the accelerometer (its noise: {noise:.3} m/s²); its forced segment and crank fit were left out"
         );
     }
-    let fits: Vec<&pendulum_explain::EnvelopeFit> =
-        envs.iter().filter_map(|e| e.env.as_ref().ok()).collect();
+    let fits = envelope_fits(&envs, &ctx);
     let pooled = pooled_envelope(&fits);
     if !pooled.is_empty() {
         let terms: Vec<String> = pooled
             .iter()
-            .map(|t| format!("{} {:.3e}", t.name, t.estimate))
+            .map(|t| format!("{} {:.3e} {}", t.name, t.estimate, t.unit))
             .collect();
         let _ = writeln!(
             text,
@@ -400,6 +401,7 @@ pub fn run(job: &DiscoverJob) -> Result<DiscoverSummary, JobError> {
         discovery: d,
         decays: Vec::new(),
         envelopes: envs.into_iter().map(|e| (e.run, e.env)).collect(),
+        pooled,
         text,
     })
 }
@@ -544,6 +546,7 @@ fn free_decays(
         },
         decays,
         envelopes: Vec::new(),
+        pooled: Vec::new(),
         text,
     })
 }
@@ -586,26 +589,57 @@ fn free_segment_envelopes(ctx: &Context) -> Vec<SegmentEnvelope> {
     out
 }
 
-/// One term of the pooled envelope fit: catalogue name, dimensionless estimate, 95 % interval.
+/// One term of the pooled envelope fit: catalogue name, SI estimate, 95 % interval, unit.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PooledTerm {
     pub name: &'static str,
     pub estimate: f64,
     pub ci_low: f64,
     pub ci_high: f64,
+    pub unit: &'static str,
+}
+
+/// The envelopes that could be read, each with its run's rig.
+fn envelope_fits<'a>(
+    envs: &'a [SegmentEnvelope],
+    ctx: &'a Context,
+) -> Vec<(&'a pendulum_explain::EnvelopeFit, &'a pendulum_process::RigParams)> {
+    envs.iter()
+        .filter_map(|e| {
+            let rig = &ctx.runs.iter().find(|r| r.id == e.run)?.rig;
+            Some((e.env.as_ref().ok()?, rig))
+        })
+        .collect()
+}
+
+/// A loss term's SI parameter → the run's dimensionless one (the weak form's factors), and its
+/// SI unit.
+fn term_si(t: pendulum_explain::Term, rig: &pendulum_process::RigParams) -> (f64, &'static str) {
+    use pendulum_explain::Term;
+    let f = pendulum_discover::weak::si_factors(rig);
+    match t {
+        Term::ViscousLinear => (f[0], "N·s/m"),
+        Term::ViscousQuadratic => (f[1], "kg/m"),
+        Term::CoulombBearing => (f[2], "1"),
+        Term::CoulombConstant => (f[4], "N·m"),
+    }
 }
 
 /// The loss per cycle of every run's free segment, pooled (a 4 s segment alone has 5–7 cycles,
 /// too few to tell the terms apart), as a non-negative sum of the catalogue's exact pendulum loss
-/// curves: the subset with the lowest BIC whose every term's 95 % interval excludes zero. Empty
+/// curves: the subset with the lowest BIC whose every term's 95 % interval excludes zero. Each
+/// run's curves carry its own SI factors (as the weak form's columns do), so a campaign that
+/// mixes bobs pools one SI parameter per term, not dimensionless ones that differ by bob. Empty
 /// with fewer than 8 cycles.
-pub fn pooled_envelope(envs: &[&pendulum_explain::EnvelopeFit]) -> Vec<PooledTerm> {
+pub fn pooled_envelope(
+    envs: &[(&pendulum_explain::EnvelopeFit, &pendulum_process::RigParams)],
+) -> Vec<PooledTerm> {
     use pendulum_explain::Term;
-    let pts: Vec<(f64, f64)> = envs
+    let pts: Vec<(f64, f64, &pendulum_process::RigParams)> = envs
         .iter()
-        .flat_map(|e| e.rows.iter())
-        .filter_map(|r| Some((r.mid_amplitude_rad?, r.loss_per_cycle_rad?)))
-        .filter(|(a, l)| a.is_finite() && l.is_finite())
+        .flat_map(|(e, rig)| e.rows.iter().map(move |r| (r, *rig)))
+        .filter_map(|(r, rig)| Some((r.mid_amplitude_rad?, r.loss_per_cycle_rad?, rig)))
+        .filter(|(a, l, _)| a.is_finite() && l.is_finite())
         .collect();
     if pts.len() < 8 {
         return Vec::new();
@@ -619,7 +653,11 @@ pub fn pooled_envelope(envs: &[&pendulum_explain::EnvelopeFit]) -> Vec<PooledTer
             .collect();
         let x: Vec<Vec<f64>> = pts
             .iter()
-            .map(|p| sub.iter().map(|t| t.loss_per_cycle(p.0)).collect())
+            .map(|p| {
+                sub.iter()
+                    .map(|t| t.loss_per_cycle(p.0) * term_si(*t, p.2).0)
+                    .collect()
+            })
             .collect();
         let Some((b, cov, rms)) = pendulum_process::linalg::lstsq(&x, &y) else {
             continue;
@@ -635,6 +673,7 @@ pub fn pooled_envelope(envs: &[&pendulum_explain::EnvelopeFit]) -> Vec<PooledTer
                     estimate: b[q],
                     ci_low: b[q] - half,
                     ci_high: b[q] + half,
+                    unit: term_si(*t, pts[0].2).1,
                 }
             })
             .collect();
@@ -844,8 +883,7 @@ fn write_report(
     }
     if !envs.is_empty() {
         let _ = writeln!(r, "\n## Free-decay segments\n\nEach run swings freely before its shaker starts. How the swing's amplitude decays says which losses dominate: a constant loss per cycle (linear decay) is dry friction, a loss proportional to the amplitude (exponential decay) is viscous, one growing with the amplitude squared (1/n-like) is quadratic drag (`envelopes.parquet`, `envelopes.png`).\n");
-        let fits: Vec<&pendulum_explain::EnvelopeFit> =
-            envs.iter().filter_map(|e| e.env.as_ref().ok()).collect();
+        let fits = envelope_fits(envs, ctx);
         let pooled = pooled_envelope(&fits);
         if !pooled.is_empty() {
             let _ = writeln!(
@@ -856,8 +894,8 @@ fn write_report(
             for t in &pooled {
                 let _ = writeln!(
                     r,
-                    "- `{}`: {:.4e} (95 % interval {:.4e} to {:.4e}, dimensionless)",
-                    t.name, t.estimate, t.ci_low, t.ci_high
+                    "- `{}`: {:.4e} {} (95 % interval {:.4e} to {:.4e})",
+                    t.name, t.estimate, t.unit, t.ci_low, t.ci_high
                 );
             }
             let _ = writeln!(
