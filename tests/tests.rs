@@ -3,6 +3,7 @@
 mod cli;
 mod discover;
 mod identify;
+mod independent;
 mod ingest;
 mod maps;
 mod real;

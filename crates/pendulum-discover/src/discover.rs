@@ -404,8 +404,9 @@ pub fn views_agree(
 }
 
 /// Paired comparison of two parameter vectors of one model on the identify runs' trajectories
-/// (initial states `ics`): the fractional fall of E_θ from `x` to `x_alt` over their 0.5 s
-/// segments and the noise it must beat (negative: `x_alt` is worse).
+/// (initial states `ics`; each vector clamped to the bounds the refit keeps to): the fractional
+/// fall of E_θ from `x` to `x_alt` over their 0.5 s segments and the noise it must beat
+/// (negative: `x_alt` is worse).
 fn trajectory_substitution(
     runs: &[PreparedRun],
     spec: &ModelSpec,
@@ -415,7 +416,15 @@ fn trajectory_substitution(
 ) -> (f64, f64) {
     let obj = refit_objective(runs, spec);
     let segments = |p: &[f64]| -> Vec<f64> {
-        let mut full = p.to_vec();
+        // Inside the parameters' bounds, as the refit is.
+        let mut full: Vec<f64> = p
+            .iter()
+            .zip(&spec.params)
+            .map(|(v, q)| {
+                let (lo, hi) = q.bounds();
+                v.clamp(lo, hi)
+            })
+            .collect();
         full.extend_from_slice(ics);
         obj.evaluate(&full).per_run_segment_e.concat()
     };
@@ -666,11 +675,7 @@ fn speed_drift_row(
     let refit_est = x.last().copied().unwrap_or(f64::NAN);
     row.refit_estimate = refit_est;
     let screen_fits = {
-        let mut xs = x.clone();
-        if let Some(v) = xs.last_mut() {
-            *v = est;
-        }
-        let (g, n) = trajectory_substitution(&id2, &spec, &x, &xs, &ics2);
+        let (g, n) = trajectory_substitution(&id2, &spec, &x, &x0, &ics2);
         g >= -n
     };
     row.accepted = gain > gain_needed && views_agree(est, half, refit_est, screen_fits);
@@ -1164,20 +1169,14 @@ pub fn discover(
                 .map_or(f64::NAN, |i| x[i]),
         };
         let possible = physically_possible(&c.effect, est);
-        // The refit's own interval: does the screen's value, put in its place, make the identify
-        // runs' trajectories significantly worse (paired 0.5 s segments)?
-        let refit_idx = match c.effect.as_str() {
-            "bearing_load_base_accel" => spec.params.iter().position(|p| *p == FitParam::Mu),
-            _ => news
-                .first()
-                .and_then(|(p, _)| spec.params.iter().position(|q| q == p)),
-        };
-        let screen_fits_trajectories = refit_idx.is_some_and(|i| {
-            let mut xs = x.clone();
-            xs[i] = est;
-            let (g, n) = trajectory_substitution(&id_runs, &spec, &x, &xs, &ics);
+        // The refit's own interval: is the screen's model (its joint estimate of the damping
+        // and the effect, where the refit started) significantly worse on the identify runs'
+        // trajectories (paired 0.5 s segments) than the refit? Substituting the effect alone
+        // would not do: the refit's other terms co-adapt to its value (μ to a dry torque).
+        let screen_fits_trajectories = {
+            let (g, n) = trajectory_substitution(&id_runs, &spec, &x, &x0, &ics);
             g >= -n
-        });
+        };
         let agree = views_agree(est, 1.96 * se, refit_est, screen_fits_trajectories);
         let accepted = excludes_zero
             && practically_significant(&c.effect, est)

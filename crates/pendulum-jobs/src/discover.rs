@@ -603,7 +603,10 @@ pub struct PooledTerm {
 fn envelope_fits<'a>(
     envs: &'a [SegmentEnvelope],
     ctx: &'a Context,
-) -> Vec<(&'a pendulum_explain::EnvelopeFit, &'a pendulum_process::RigParams)> {
+) -> Vec<(
+    &'a pendulum_explain::EnvelopeFit,
+    &'a pendulum_process::RigParams,
+)> {
     envs.iter()
         .filter_map(|e| {
             let rig = &ctx.runs.iter().find(|r| r.id == e.run)?.rig;
