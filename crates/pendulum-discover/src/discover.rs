@@ -352,12 +352,41 @@ fn to_si(c: &Candidate, fit: &crate::screen::Ols) -> (f64, f64, &'static str) {
 
 /// Effects whose size is within the rig's normal tolerances are not named: the encoder is zeroed
 /// by hand to within a few counts (rig.md), so an offset under 4 counts (6 mrad) is not the effect
-/// `encoder_offset`.
-fn practically_significant(effect: &str, estimate: f64) -> bool {
+/// `encoder_offset`; the firmware stamps each sample to within the jitter rig.md states ("tens of
+/// µs"), so a lag within two standard deviations of one accelerometer stamp's timing error
+/// (`stamp_jitter_s`, measured on the campaign) is the stamps' own accuracy, not the effect
+/// `accel_delay`. (A low-pass filter whose delay is compensated for its DC group delay leaves a
+/// few tens of µs on the crank's harmonics; real lags are milliseconds.)
+fn practically_significant(effect: &str, estimate: f64, stamp_jitter_s: f64) -> bool {
     match effect {
         "encoder_offset" => estimate.abs() > crate::screen::ENCODER_OFFSET_FLOOR_RAD,
+        "accel_delay" => !(estimate.abs() <= 2.0 * stamp_jitter_s),
         _ => true,
     }
+}
+
+/// The timing error of one accelerometer stamp, s: the robust spread (1.4826 × MAD) of the
+/// sample spacings about their run's median, pooled over the shaker runs, over √2 (a spacing is
+/// the difference of two stamps). NaN without enough samples.
+fn stamp_jitter_s(ctx: &Context) -> f64 {
+    let mut dev: Vec<f64> = Vec::new();
+    for run in &ctx.runs {
+        let mut d: Vec<f64> = run.acc_t_s.windows(2).map(|w| w[1] - w[0]).collect();
+        if d.len() < 100 {
+            continue;
+        }
+        let mut sorted = d.clone();
+        sorted.sort_by(f64::total_cmp);
+        let med = sorted[sorted.len() / 2];
+        // Gaps (dropouts) are not jitter.
+        d.retain(|v| (v - med).abs() < 0.5 * med);
+        dev.extend(d.iter().map(|v| (v - med).abs()));
+    }
+    if dev.len() < 100 {
+        return f64::NAN;
+    }
+    dev.sort_by(f64::total_cmp);
+    1.4826 * dev[dev.len() / 2] / std::f64::consts::SQRT_2
 }
 
 /// Whether an estimate is in its effect's physical range: every dissipative term (b, a, μ, the
@@ -965,6 +994,7 @@ pub fn discover(
         });
     }
 
+    let jitter_s = stamp_jitter_s(ctx);
     // A drifting crank speed, read from the accelerometer first: when it is significant the
     // equation-error view uses the re-aligned forcing, so that its growing phase error is not
     // mistaken for another effect (an accelerometer lag, say).
@@ -1179,7 +1209,7 @@ pub fn discover(
         };
         let agree = views_agree(est, 1.96 * se, refit_est, screen_fits_trajectories);
         let accepted = excludes_zero
-            && practically_significant(&c.effect, est)
+            && practically_significant(&c.effect, est, jitter_s)
             && sc.delta_bic < cfg.screen_threshold
             && held_out
             && possible
@@ -1226,6 +1256,8 @@ pub fn discover(
                 },
                 if !possible {
                     "; outside its physical range: not accepted"
+                } else if !practically_significant(&c.effect, est, jitter_s) {
+                    "; within the rig's own tolerance (encoder zeroing, or the stamps' timing jitter): not named"
                 } else if !agree {
                     "; the trajectory refit disagrees with the screen: not accepted"
                 } else {
