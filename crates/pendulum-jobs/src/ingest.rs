@@ -42,7 +42,13 @@ impl IngestSummary {
 
 impl std::fmt::Display for IngestSummary {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        writeln!(f, "campaign {}: {} runs", self.campaign, self.rows.len())?;
+        // The name comes from campaign.toml: printed with any terminal code escaped.
+        writeln!(
+            f,
+            "campaign {}: {} runs",
+            pendulum_rig::names::printable(&self.campaign),
+            self.rows.len()
+        )?;
         writeln!(
             f,
             "{:<10} {:<10} {:>9} {:>8} {:>8} {:>8} {:>5} {:>6} {:>6} {:>6}",
@@ -252,7 +258,7 @@ pub fn run(dir: &Path, out_dir: &Path, show_progress: bool) -> Result<IngestSumm
         .runs
         .par_iter()
         .map(|spec| {
-            let row = if !spec.file.is_file() {
+            let mut row = if !spec.file.is_file() {
                 IngestRow {
                     run_id: spec.id.clone(),
                     format: "-".into(),
@@ -271,9 +277,18 @@ pub fn run(dir: &Path, out_dir: &Path, show_progress: bool) -> Result<IngestSumm
                     warnings: Vec::new(),
                 })
             };
-            if row.error.is_some() {
-                // A stale <id>.mcap from an earlier ingest would make the folder look complete.
-                let _ = std::fs::remove_file(out_dir.join(format!("{}.mcap", spec.id)));
+            // A failed run's own temporary file is gone (the writer removes it). An `<id>.mcap`
+            // already in OUT is not this process's to delete: it may be an earlier ingest's, or
+            // another ingest's finishing right now into the same folder. The failure says it is
+            // there and stale instead.
+            if let Some(e) = &mut row.error {
+                let earlier = out_dir.join(format!("{}.mcap", spec.id));
+                if earlier.exists() {
+                    e.push_str(&format!(
+                        "; {} is NOT from this ingest (left as it was)",
+                        earlier.display()
+                    ));
+                }
             }
             bar.set_message(spec.id.clone());
             bar.inc(1);

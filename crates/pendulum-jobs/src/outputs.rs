@@ -354,6 +354,20 @@ pub fn models_of(ctx: &Context) -> Vec<FitOutcome> {
     }
 }
 
+/// `out/name` for a file name built from a model name and a run id. `validate` reads the model
+/// name from a params.parquet and the run ids may come from MCAP metadata: whoever wrote those
+/// files must not be able to place a plot outside `out` (a name like `../../x`).
+fn out_file(out: &Path, name: &str) -> Result<PathBuf, JobError> {
+    pendulum_rig::names::check_file_name(name).map_err(|problem| {
+        JobError::Invalid(format!(
+            "{}: refusing to write the plot {name:?}: the name (built from a model name and a \
+             run id read from the input) {problem}",
+            out.display()
+        ))
+    })?;
+    Ok(out.join(name))
+}
+
 /// Writes every table and plot for the context's results into `out`.
 pub fn write_outputs(
     ctx: &Context,
@@ -543,11 +557,10 @@ pub fn write_outputs(
                     col.push(x);
                 }
             }
-            let png = out.join(format!(
-                "history_{}_{}.png",
-                m.spec.name.replace('+', "_"),
-                id
-            ));
+            let png = out_file(
+                out,
+                &format!("history_{}_{}.png", m.spec.name.replace('+', "_"), id),
+            )?;
             let x_label = if m.spec.is_free_decay() {
                 "time from the first turning point (s)"
             } else {
@@ -557,7 +570,10 @@ pub fn write_outputs(
             plots.push(png);
         }
         if m.convergence.len() > 1 {
-            let png = out.join(format!("convergence_{}.png", m.spec.name.replace('+', "_")));
+            let png = out_file(
+                out,
+                &format!("convergence_{}.png", m.spec.name.replace('+', "_")),
+            )?;
             convergence_plot(&png, m)?;
             plots.push(png);
         }
@@ -762,4 +778,29 @@ fn convergence_plot(path: &Path, m: &FitOutcome) -> Result<(), JobError> {
     };
     fig.save_png(path)?;
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A model name read from someone's params.parquet (validate) cannot place a plot outside
+    /// the output folder.
+    #[test]
+    fn issue_13_plot_names_from_inputs_stay_in_out() {
+        let out = Path::new("/data/out");
+        assert_eq!(
+            out_file(out, "history_reference_r01.png").unwrap(),
+            out.join("history_reference_r01.png")
+        );
+        for name in [
+            "history_../../x_r01.png",
+            "history_/etc/cron.d/x_r01.png",
+            "history_a\u{1b}[2J_r01.png",
+        ] {
+            let e = out_file(out, name).unwrap_err().to_string();
+            assert!(e.contains("refusing to write the plot"), "{e}");
+            assert!(!e.contains('\u{1b}'), "{e:?}");
+        }
+    }
 }

@@ -1,0 +1,251 @@
+//! Hostile and damaged inputs (issue 13): what a campaign folder, a twin case or an MCAP written
+//! by someone else may not make the program do. Each test reproduces one of the issue's
+//! reproduction scripts (`shared/repro/reliability/`) and fails on the code before its fix.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::Output;
+
+use pendulum_log::{EncoderMsg, RunLogOptions, METADATA_RUN};
+
+use crate::ingest::{tiny_capture, GOOD_RIG};
+use crate::util::pendulum;
+
+fn text(o: &Output) -> (String, String) {
+    (
+        String::from_utf8_lossy(&o.stdout).into_owned(),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+    )
+}
+
+fn ingest(camp: &Path, out: &Path) -> Output {
+    pendulum()
+        .arg("ingest")
+        .arg(camp)
+        .arg("--out")
+        .arg(out)
+        .arg("--quiet")
+        .output()
+        .unwrap()
+}
+
+/// Every file under `dir`, relative, sorted.
+fn tree(dir: &Path) -> Vec<String> {
+    fn walk(base: &Path, dir: &Path, out: &mut Vec<String>) {
+        for e in std::fs::read_dir(dir).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                walk(base, &p, out);
+            } else {
+                out.push(p.strip_prefix(base).unwrap().display().to_string());
+            }
+        }
+    }
+    let mut out = Vec::new();
+    walk(dir, dir, &mut out);
+    out.sort();
+    out
+}
+
+/// A campaign folder `root/camp` with `r01.csv` and the given `[[run]]` tables.
+fn campaign(root: &Path, runs: &str) -> PathBuf {
+    let camp = root.join("camp");
+    std::fs::create_dir_all(&camp).unwrap();
+    std::fs::write(camp.join("r01.csv"), tiny_capture()).unwrap();
+    std::fs::write(camp.join("campaign.toml"), format!("{GOOD_RIG}{runs}")).unwrap();
+    camp
+}
+
+/// Script 01: run ids and `file` keys that would lead outside the campaign folder (reads) or
+/// the output folder (writes) are refused before anything is read or written, with an error
+/// naming campaign.toml, the run and what an id must look like; the escape codes of a hostile
+/// id never reach the terminal. Before the fix `id = "../escaped"` wrote `escaped.mcap` beside
+/// OUT, and a failing run with an absolute id deleted `<id>.mcap` wherever it pointed.
+#[test]
+fn issue_13_campaign_ids_and_files_cannot_leave_their_folders() {
+    let root = tempfile::tempdir().unwrap();
+    let victim = root.path().join("victim");
+    std::fs::create_dir_all(&victim).unwrap();
+    std::fs::write(victim.join("precious.mcap"), "precious").unwrap();
+    let precious = victim.join("precious");
+    let run = |id: &str, file: &str| {
+        format!("[[run]]\nid = \"{id}\"\nfile = \"{file}\"\nrole = \"identify\"\n")
+    };
+    let cases: Vec<(&str, String, Vec<&str>)> = vec![
+        (
+            "relative id",
+            run("../escaped", "r01.csv"),
+            vec![
+                "run `run #1`",
+                "key `id`",
+                "\"../escaped\"",
+                "path separator",
+            ],
+        ),
+        (
+            "absolute id of a run that fails",
+            format!(
+                "{}{}",
+                run("r01", "r01.csv"),
+                run(&precious.display().to_string(), "missing.csv")
+            ),
+            vec!["run `run #2`", "key `id`", "path separator"],
+        ),
+        (
+            "escape codes in the id",
+            run("r01\\u001b]0;owned\\u0007\\u001b[2J", "r01.csv"),
+            vec!["run `run #1`", "control character", "\\u{1b}"],
+        ),
+        ("dot-dot id", run("..", "r01.csv"), vec!["starts with '.'"]),
+        (
+            "reserved id",
+            run("NUL", "r01.csv"),
+            vec!["reserved device name"],
+        ),
+        (
+            "file outside the folder",
+            run("r01", "../camp/r01.csv"),
+            vec!["run `r01`", "key `file`", "contains '..'"],
+        ),
+        (
+            "absolute file",
+            run(
+                "r01",
+                &root.path().join("camp/r01.csv").display().to_string(),
+            ),
+            vec!["run `r01`", "key `file`", "absolute path"],
+        ),
+    ];
+    for (what, runs, needles) in cases {
+        let dir = root.path().join(what.replace(' ', "_"));
+        let camp = campaign(&dir, &runs);
+        let out = dir.join("out").join("inner");
+        let o = ingest(&camp, &out);
+        let (stdout, stderr) = text(&o);
+        assert_eq!(o.status.code(), Some(1), "{what}: {stdout}{stderr}");
+        assert!(stderr.contains("campaign.toml"), "{what}: {stderr}");
+        for n in needles.iter().chain(&["expected"]) {
+            assert!(stderr.contains(n), "{what}: {n:?} in {stderr}");
+        }
+        assert!(
+            !stdout.contains('\u{1b}') && !stderr.contains('\u{1b}'),
+            "{what}: an escape code reached the terminal: {stderr:?}"
+        );
+        // Nothing written anywhere: the campaign is refused as a whole.
+        assert_eq!(tree(&dir), ["camp/campaign.toml", "camp/r01.csv"], "{what}");
+        assert_eq!(
+            std::fs::read_to_string(victim.join("precious.mcap")).unwrap(),
+            "precious",
+            "{what}"
+        );
+    }
+}
+
+/// Script 01's clean-up half: a run that fails must not delete an `<id>.mcap` this ingest did
+/// not write (before the fix it removed any earlier or concurrent file of that name). The
+/// failure says that the file there is not from this ingest.
+#[test]
+fn issue_13_a_failed_run_deletes_nothing_it_did_not_create() {
+    let root = tempfile::tempdir().unwrap();
+    let camp = campaign(
+        root.path(),
+        "[[run]]\nid = \"r01\"\nfile = \"r01.csv\"\nrole = \"identify\"\n\
+         [[run]]\nid = \"r02\"\nfile = \"missing.csv\"\nrole = \"identify\"\n",
+    );
+    let out = root.path().join("out");
+    std::fs::create_dir_all(&out).unwrap();
+    std::fs::write(out.join("r02.mcap"), "an earlier ingest's").unwrap();
+    let o = ingest(&camp, &out);
+    let (stdout, stderr) = text(&o);
+    assert_eq!(o.status.code(), Some(1), "{stdout}{stderr}");
+    assert_eq!(
+        std::fs::read_to_string(out.join("r02.mcap")).unwrap(),
+        "an earlier ingest's"
+    );
+    let row = stdout.lines().find(|l| l.starts_with("r02")).unwrap();
+    assert!(
+        row.contains("FAILED") && row.contains("r02.mcap is NOT from this ingest"),
+        "{row}"
+    );
+    assert!(out.join("r01.mcap").is_file());
+}
+
+/// A twin case whose run id is not a safe file name is refused before anything is simulated
+/// or written (the twin names its captures `<id>.csv`).
+#[test]
+fn issue_13_synth_refuses_unsafe_run_ids() {
+    let root = tempfile::tempdir().unwrap();
+    let case = root.path().join("case.toml");
+    std::fs::write(
+        &case,
+        "name = \"bad\"\nseed = 1\n[rig]\nm_kg = 1.46\nl_m = 0.265\ncrank_r_m = 0.0725\n\
+         rod_L_m = 0.575\nr_b_m = 0.01225\n[truth]\nb_n_s_m = 0.5\nmu = 0.15\n\
+         [[run]]\nid = \"ok\"\nomega_hz = 1.54\nrole = \"identify\"\nformat = \"serial\"\n\
+         theta0_rad = 0.5\nfree_s = 0.5\nforced_s = 0.5\n\
+         [[run]]\nid = \"../../escaped\"\nomega_hz = 1.54\nrole = \"identify\"\n\
+         format = \"serial\"\ntheta0_rad = 0.5\nfree_s = 0.5\nforced_s = 0.5\n",
+    )
+    .unwrap();
+    let out = root.path().join("a").join("b");
+    let o = pendulum()
+        .arg("synth")
+        .arg(&case)
+        .arg(&out)
+        .output()
+        .unwrap();
+    let (stdout, stderr) = text(&o);
+    assert_eq!(o.status.code(), Some(1), "{stdout}{stderr}");
+    for n in [
+        "case.toml",
+        "run `run #2`",
+        "key `id`",
+        "\"../../escaped\"",
+        "path separator",
+        "expected",
+    ] {
+        assert!(stderr.contains(n), "{n:?} in {stderr}");
+    }
+    assert_eq!(tree(root.path()), ["case.toml"]);
+}
+
+/// An MCAP's `run.id` names output files of identify and validate as a campaign's id does: the
+/// same rule applies when a folder of MCAP files is read.
+#[test]
+fn issue_13_mcap_run_ids_are_checked_too() {
+    let root = tempfile::tempdir().unwrap();
+    let dir = root.path().join("mcap");
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut meta = BTreeMap::new();
+    for (k, v) in [
+        ("id", "../../outside"),
+        ("role", "identify"),
+        ("m_kg", "1.46"),
+        ("l_m", "0.265"),
+        ("crank_r_m", "0.0725"),
+        ("rod_L_m", "0.575"),
+        ("r_b_m", "0.01225"),
+        ("g_m_s2", "9.81"),
+    ] {
+        meta.insert(k.to_string(), v.to_string());
+    }
+    let mut w = RunLogOptions::new().create(&dir.join("r01.mcap")).unwrap();
+    w.write_metadata(METADATA_RUN, meta).unwrap();
+    for k in 0..10u64 {
+        w.write_encoder(&EncoderMsg {
+            t_s: k as f64 * 0.005,
+            t_us: k * 5000,
+            count: 0,
+            count_raw: 0,
+            theta_rad: 0.0,
+        })
+        .unwrap();
+    }
+    w.finish().unwrap();
+    let e = match pendulum_jobs::runs::load_runs(&dir) {
+        Ok(_) => panic!("a hostile run.id was accepted"),
+        Err(e) => e.to_string(),
+    };
+    for n in ["r01.mcap", "run.id", "\"../../outside\"", "path separator"] {
+        assert!(e.contains(n), "{n:?} in {e}");
+    }
+}
