@@ -249,3 +249,165 @@ fn issue_13_mcap_run_ids_are_checked_too() {
         assert!(e.contains(n), "{n:?} in {e}");
     }
 }
+
+/// The small twin campaign of the reproduction scripts (3 runs of 10 s), ingested into `mc`
+/// and identified (a short fit) into `idr`, under `root`.
+fn identified_campaign(root: &Path) -> (PathBuf, PathBuf) {
+    let case = root.join("small.toml");
+    std::fs::write(
+        &case,
+        "name = \"small-twin\"\nseed = 7\n[rig]\nm_kg = 1.46\nl_m = 0.265\ncrank_r_m = 0.0725\n\
+         rod_L_m = 0.575\nr_b_m = 0.01225\n[truth]\nb_n_s_m = 0.5\nmu = 0.15\n\
+         [[run]]\nid = \"r01\"\nomega_hz = 1.54\nrole = \"identify\"\nformat = \"serial\"\n\
+         theta0_rad = 0.5\nfree_s = 2\nforced_s = 8\n\
+         [[run]]\nid = \"v01\"\nomega_hz = 1.54\nrole = \"validate\"\nformat = \"sd\"\n\
+         theta0_rad = 0.3\ntheta_dot0_rad_s = 6\nfree_s = 2\nforced_s = 8\n",
+    )
+    .unwrap();
+    let camp = root.join("camp");
+    let mc = root.join("mc");
+    let idr = root.join("idr");
+    for args in [
+        vec!["synth".as_ref(), case.as_os_str(), camp.as_os_str()],
+        vec![
+            "ingest".as_ref(),
+            camp.as_os_str(),
+            "--out".as_ref(),
+            mc.as_os_str(),
+            "--quiet".as_ref(),
+        ],
+        vec![
+            "identify".as_ref(),
+            mc.as_os_str(),
+            "--out".as_ref(),
+            idr.as_os_str(),
+            "--np".as_ref(),
+            "10".as_ref(),
+            "--generations".as_ref(),
+            "2".as_ref(),
+            "--quiet".as_ref(),
+        ],
+    ] {
+        let o = pendulum().args(&args).output().unwrap();
+        assert!(o.status.success(), "{args:?}: {:?}", text(&o));
+    }
+    (mc, idr)
+}
+
+/// Asserts that `o` failed with the "same file" refusal naming both paths' roles.
+fn assert_refused(o: &Output, what_out: &str, what_in: &str) {
+    let (stdout, stderr) = text(o);
+    assert_eq!(o.status.code(), Some(1), "{stdout}{stderr}");
+    for n in [
+        what_out,
+        what_in,
+        "is the same file as",
+        "refusing to overwrite an input",
+    ] {
+        assert!(stderr.contains(n), "{n:?} in {stderr}");
+    }
+}
+
+/// Script 08: an output path that is one of the command's inputs is refused before anything is
+/// written, and the input is left byte for byte. Before the fix `replay --out P --params P`
+/// replaced params.parquet with an MCAP (exit 0), `validate --params OUT/params.parquet --out
+/// OUT` rewrote it, and ingest into the campaign folder replaced a capture named `<id>.mcap`.
+#[test]
+fn issue_13_an_output_never_overwrites_an_input() {
+    let root = tempfile::tempdir().unwrap();
+    let (mc, idr) = identified_campaign(root.path());
+    let params = idr.join("params.parquet");
+    let params_bytes = std::fs::read(&params).unwrap();
+    let run = mc.join("r01.mcap");
+    let run_bytes = std::fs::read(&run).unwrap();
+
+    // replay: --out is --params (spelled differently), or RUN itself.
+    let other_spelling = idr.join("..").join("idr").join("params.parquet");
+    let o = pendulum()
+        .arg("replay")
+        .arg(&run)
+        .arg("--params")
+        .arg(&params)
+        .args(["--model", "reference", "--out"])
+        .arg(&other_spelling)
+        .output()
+        .unwrap();
+    assert_refused(&o, "--out", "--params");
+    let o = pendulum()
+        .arg("replay")
+        .arg(&run)
+        .arg("--params")
+        .arg(&params)
+        .args(["--model", "reference", "--out"])
+        .arg(&run)
+        .output()
+        .unwrap();
+    assert_refused(&o, "--out", "RUN");
+
+    // validate into the folder that holds its --params: params.parquet would be rewritten.
+    let o = pendulum()
+        .arg("validate")
+        .arg(&mc)
+        .arg("--params")
+        .arg(&params)
+        .arg("--out")
+        .arg(&idr)
+        .output()
+        .unwrap();
+    assert_refused(&o, "the output", "--params");
+
+    // bifurcate: its table over the --params file.
+    let bif = root.path().join("bif");
+    std::fs::create_dir_all(&bif).unwrap();
+    std::fs::copy(&params, bif.join("bifurcation.parquet")).unwrap();
+    let o = pendulum()
+        .arg("bifurcate")
+        .arg("--params")
+        .arg(bif.join("bifurcation.parquet"))
+        .args(["--model", "reference", "--sweep", "omega=1.0", "--out"])
+        .arg(&bif)
+        .output()
+        .unwrap();
+    assert_refused(&o, "the output", "--params");
+    assert_eq!(
+        std::fs::read(bif.join("bifurcation.parquet")).unwrap(),
+        params_bytes
+    );
+
+    assert_eq!(
+        std::fs::read(&params).unwrap(),
+        params_bytes,
+        "params.parquet changed"
+    );
+    assert_eq!(std::fs::read(&run).unwrap(), run_bytes, "r01.mcap changed");
+
+    // ingest with OUT = the campaign folder, where a capture is named like a run's output.
+    let camp = root.path().join("camp2");
+    std::fs::create_dir_all(&camp).unwrap();
+    std::fs::write(camp.join("r01.mcap"), tiny_capture()).unwrap();
+    std::fs::write(
+        camp.join("campaign.toml"),
+        format!("{GOOD_RIG}[[run]]\nid = \"r01\"\nfile = \"r01.mcap\"\nrole = \"identify\"\n"),
+    )
+    .unwrap();
+    let o = ingest(&camp, &camp);
+    assert_refused(&o, "the output of run r01", "run r01's capture");
+    assert_eq!(
+        std::fs::read(camp.join("r01.mcap")).unwrap(),
+        tiny_capture()
+    );
+
+    // synth: a case file in OUT under a name the twin writes.
+    let out = root.path().join("twin");
+    std::fs::create_dir_all(&out).unwrap();
+    let case = std::fs::read(root.path().join("small.toml")).unwrap();
+    std::fs::write(out.join("campaign.toml"), &case).unwrap();
+    let o = pendulum()
+        .arg("synth")
+        .arg(out.join("campaign.toml"))
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert_refused(&o, "the output", "the case file");
+    assert_eq!(std::fs::read(out.join("campaign.toml")).unwrap(), case);
+}

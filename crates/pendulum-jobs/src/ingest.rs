@@ -11,6 +11,7 @@ use pendulum_log::{
 use pendulum_rig::{Campaign, CaptureReader, IngestStats, Location, ReadOptions, RunSpec, Sample};
 use rayon::prelude::*;
 
+use crate::inputs::Inputs;
 use crate::runs::run_metadata;
 use crate::JobError;
 
@@ -184,7 +185,7 @@ fn ingest_run(c: &Campaign, spec: &RunSpec, out_dir: &Path) -> Result<IngestRow,
         },
         None => None,
     };
-    let path = out_dir.join(format!("{}.mcap", spec.id));
+    let path = mcap_path(out_dir, spec);
     let mut w = RunLogOptions::new()
         .library(concat!("pendulum/", env!("CARGO_PKG_VERSION")))
         .start_ns(start_ns)
@@ -237,9 +238,24 @@ fn ingest_run(c: &Campaign, spec: &RunSpec, out_dir: &Path) -> Result<IngestRow,
     })
 }
 
+/// Where a run's MCAP goes (the id is a safe file name: [`pendulum_rig::names`]).
+fn mcap_path(out_dir: &Path, spec: &RunSpec) -> PathBuf {
+    out_dir.join(format!("{}.mcap", spec.id))
+}
+
 /// Ingests every run of the campaign at `dir` into `out_dir`.
 pub fn run(dir: &Path, out_dir: &Path, show_progress: bool) -> Result<IngestSummary, JobError> {
     let c = Campaign::load(dir)?;
+    // OUT may be the campaign folder itself: no `<id>.mcap` may replace campaign.toml or a
+    // capture. Checked for every run before anything is written.
+    let mut inputs = Inputs::new();
+    inputs.add_campaign(&c, dir);
+    for spec in &c.runs {
+        inputs.check_output(
+            &format!("the output of run {}", spec.id),
+            &mcap_path(out_dir, spec),
+        )?;
+    }
     std::fs::create_dir_all(out_dir).map_err(|source| JobError::Io {
         path: out_dir.to_path_buf(),
         source,
@@ -282,7 +298,7 @@ pub fn run(dir: &Path, out_dir: &Path, show_progress: bool) -> Result<IngestSumm
             // another ingest's finishing right now into the same folder. The failure says it is
             // there and stale instead.
             if let Some(e) = &mut row.error {
-                let earlier = out_dir.join(format!("{}.mcap", spec.id));
+                let earlier = mcap_path(out_dir, spec);
                 if earlier.exists() {
                     e.push_str(&format!(
                         "; {} is NOT from this ingest (left as it was)",
