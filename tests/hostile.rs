@@ -253,6 +253,7 @@ fn issue_13_mcap_run_ids_are_checked_too() {
 /// The small twin campaign of the reproduction scripts (3 runs of 10 s), ingested into `mc`
 /// and identified (a short fit) into `idr`, under `root`.
 fn identified_campaign(root: &Path) -> (PathBuf, PathBuf) {
+    std::fs::create_dir_all(root).unwrap();
     let case = root.join("small.toml");
     std::fs::write(
         &case,
@@ -410,4 +411,81 @@ fn issue_13_an_output_never_overwrites_an_input() {
         .unwrap();
     assert_refused(&o, "the output", "the case file");
     assert_eq!(std::fs::read(out.join("campaign.toml")).unwrap(), case);
+}
+
+/// Issue 13, item 10 (messages): an empty capture says "file is empty"; an implausible
+/// `accel_lsb_per_g` names the capture's header key (it used to name the output MCAP's field
+/// `ax_m_s2`); `--np` below the smallest population says it was raised.
+#[test]
+fn issue_13_messages_name_the_cause() {
+    let root = tempfile::tempdir().unwrap();
+    let capture = String::from_utf8(tiny_capture()).unwrap();
+    let camp = campaign(
+        root.path(),
+        "[[run]]\nid = \"r01\"\nfile = \"r01.csv\"\nrole = \"identify\"\n\
+         [[run]]\nid = \"empty\"\nfile = \"empty.csv\"\nrole = \"identify\"\n\
+         [[run]]\nid = \"lsb\"\nfile = \"lsb.csv\"\nrole = \"identify\"\n",
+    );
+    std::fs::write(camp.join("empty.csv"), "").unwrap();
+    std::fs::write(
+        camp.join("lsb.csv"),
+        capture.replace("accel_lsb_per_g=8192", "accel_lsb_per_g=1e-320"),
+    )
+    .unwrap();
+    let out = root.path().join("out");
+    let o = ingest(&camp, &out);
+    let (stdout, stderr) = text(&o);
+    assert_eq!(o.status.code(), Some(1), "{stdout}{stderr}");
+    let row = |id: &str| {
+        stdout
+            .lines()
+            .find(|l| l.starts_with(id))
+            .unwrap_or_else(|| panic!("row {id} in {stdout}"))
+            .to_string()
+    };
+    let empty = row("empty");
+    assert!(
+        empty.contains("empty.csv") && empty.contains("file is empty"),
+        "{empty}"
+    );
+    let lsb = row("lsb");
+    assert!(
+        lsb.contains("lsb.csv")
+            && lsb.contains("header key `accel_lsb_per_g`")
+            && lsb.contains("1e-320")
+            && !lsb.contains(".mcap"),
+        "{lsb}"
+    );
+
+    // The same for a generic time series.
+    let ts = root.path().join("ts");
+    std::fs::create_dir_all(&ts).unwrap();
+    std::fs::write(ts.join("e.csv"), "").unwrap();
+    std::fs::write(
+        ts.join("campaign.toml"),
+        "[rig]\nformat = \"timeseries\"\ntime_column = \"t\"\nangle_column = \"a\"\n\
+         angle_unit = \"rad\"\nrole = \"identify\"\n[[run]]\nid = \"e\"\nfile = \"e.csv\"\n",
+    )
+    .unwrap();
+    let (stdout, _) = text(&ingest(&ts, &root.path().join("ts_out")));
+    assert!(
+        stdout.contains("e.csv: not a rig capture (line 1): file is empty"),
+        "{stdout}"
+    );
+
+    let (mc, _) = identified_campaign(&root.path().join("twin"));
+    let o = pendulum()
+        .arg("identify")
+        .arg(&mc)
+        .arg("--out")
+        .arg(root.path().join("np"))
+        .args(["--np", "2", "--generations", "1", "--quiet"])
+        .output()
+        .unwrap();
+    let (stdout, stderr) = text(&o);
+    assert!(o.status.success(), "{stdout}{stderr}");
+    assert!(
+        stdout.contains("note: --np 2 raised to 4"),
+        "{stdout}{stderr}"
+    );
 }

@@ -7,7 +7,7 @@ use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressStyle};
 use pendulum_fit::StopRule;
-use pendulum_process::identify::{residual_series, FitOutcome, ResidualSeries, RunFit};
+use pendulum_process::identify::{residual_series, FitOutcome, ResidualSeries, RunFit, MIN_NP};
 use pendulum_process::pipeline::{Context, PipelineConfig, StageConfig};
 use pendulum_process::{Role, RunData};
 
@@ -209,6 +209,21 @@ pub fn run(job: &IdentifyJob) -> Result<OutputSummary, JobError> {
         )));
     }
     let mut ctx = Context::new(runs);
+    // The fit silently runs with at least MIN_NP members: say so, naming where np came from.
+    if let Some(np) = pipeline
+        .fit_mut()
+        .and_then(|f| f.np)
+        .filter(|&n| n < MIN_NP)
+    {
+        let from = if job.overrides.np.is_some() {
+            format!("--np {np}")
+        } else {
+            format!("the pipeline's np = {np}")
+        };
+        ctx.notes.push(format!(
+            "{from} raised to {MIN_NP}: differential evolution needs at least {MIN_NP} members"
+        ));
+    }
     let max_gen = pipeline.fit_mut().map_or(0, |f| f.max_generations);
     let bar = if job.progress {
         let (bar, f) = generation_bar(max_gen);
