@@ -181,9 +181,9 @@ fn issue_13_synth_refuses_unsafe_run_ids() {
         "name = \"bad\"\nseed = 1\n[rig]\nm_kg = 1.46\nl_m = 0.265\ncrank_r_m = 0.0725\n\
          rod_L_m = 0.575\nr_b_m = 0.01225\n[truth]\nb_n_s_m = 0.5\nmu = 0.15\n\
          [[run]]\nid = \"ok\"\nomega_hz = 1.54\nrole = \"identify\"\nformat = \"serial\"\n\
-         theta0_rad = 0.5\nfree_s = 0.5\nforced_s = 0.5\n\
+         theta0_rad = 0.5\nfree_s = 0.5\nforced_s = 3\n\
          [[run]]\nid = \"../../escaped\"\nomega_hz = 1.54\nrole = \"identify\"\n\
-         format = \"serial\"\ntheta0_rad = 0.5\nfree_s = 0.5\nforced_s = 0.5\n",
+         format = \"serial\"\ntheta0_rad = 0.5\nfree_s = 0.5\nforced_s = 3\n",
     )
     .unwrap();
     let out = root.path().join("a").join("b");
