@@ -1280,11 +1280,12 @@ forced_s = 8
 // 4. Bad input: clear errors, no partial files
 // ---------------------------------------------------------------------------------------------
 
-const GOOD_RIG: &str = "[rig]\nm_kg = 1.46\nl_m = 0.265\ncrank_r_m = 0.0725\nrod_L_m = 0.575\n\
+pub(crate) const GOOD_RIG: &str =
+    "[rig]\nm_kg = 1.46\nl_m = 0.265\ncrank_r_m = 0.0725\nrod_L_m = 0.575\n\
                         r_b_m = 0.01225\n";
 
 /// A small undamaged serial capture, written the way the firmware does.
-fn tiny_capture() -> Vec<u8> {
+pub(crate) fn tiny_capture() -> Vec<u8> {
     let mut s = String::from(
         "# firmware=serial-v1\n# encoder_cpr=4096\n# accel_lsb_per_g=8192\n# sample_hz=200\n\
          # started=2026-03-14T10:22:05Z\nt_us,enc,ax,ay,az\n",

@@ -42,8 +42,7 @@ fn data_dir() -> PathBuf {
 
 /// The campaign: the arm's mass and centre-of-mass distance in `[rig]` (the other rig keys are
 /// left out: optional for time series), no `omega_hz` (no shaker).
-fn campaign_toml(data: &Path) -> String {
-    let file = |name: &str| data.join(name).display().to_string().replace('\\', "/");
+fn campaign_toml() -> String {
     format!(
         r#"name = "multiarm-free-swing"
 g_m_s2 = {G}
@@ -61,16 +60,31 @@ role = "identify"
 
 [[run]]
 id = "small"
-file = "{small}"
+file = "{SMALL}"
 
 [[run]]
 id = "large"
-file = "{large}"
+file = "{LARGE}"
 "#,
         pi = std::f64::consts::PI,
-        small = file("single_small_amplitude_1khz.csv"),
-        large = file("single_large_amplitude_1khz.csv"),
     )
+}
+
+const SMALL: &str = "single_small_amplitude_1khz.csv";
+const LARGE: &str = "single_large_amplitude_1khz.csv";
+
+/// A campaign folder `camp` with `toml` and the two recordings. A run's file must lie inside its
+/// campaign folder (issue 13), so the recordings are linked in (copied where links are not
+/// available), as `campaigns/multiarm` links them.
+fn write_campaign(camp: &Path, data: &Path, toml: &str) {
+    std::fs::create_dir_all(camp).expect("campaign dir");
+    std::fs::write(camp.join("campaign.toml"), toml).expect("write campaign");
+    for name in [SMALL, LARGE] {
+        #[cfg(unix)]
+        std::os::unix::fs::symlink(data.join(name), camp.join(name)).expect("link recording");
+        #[cfg(not(unix))]
+        std::fs::copy(data.join(name), camp.join(name)).expect("copy recording");
+    }
 }
 
 /// The authors' viscous-only model in identifiable ratios.
@@ -112,8 +126,7 @@ fn multiarm_free_decays_need_dry_friction() {
     let data = data_dir();
     let tmp = tempfile::tempdir().expect("temp dir");
     let camp = tmp.path().join("campaign");
-    std::fs::create_dir_all(&camp).expect("campaign dir");
-    std::fs::write(camp.join("campaign.toml"), campaign_toml(&data)).expect("write campaign");
+    write_campaign(&camp, &data, &campaign_toml());
     let out = tmp.path().join("mcap");
 
     // Ingest: every line read, nothing skipped, rig keys left out are unknown (NaN).
@@ -291,8 +304,7 @@ fn multiarm_discover_command_names_dry_friction() {
     let data = data_dir();
     let tmp = tempfile::tempdir().expect("temp dir");
     let camp = tmp.path().join("campaign");
-    std::fs::create_dir_all(&camp).expect("campaign dir");
-    std::fs::write(camp.join("campaign.toml"), campaign_toml(&data)).expect("write campaign");
+    write_campaign(&camp, &data, &campaign_toml());
     let out = tmp.path().join("out");
     let o = std::process::Command::new(env!("CARGO_BIN_EXE_pendulum"))
         .args(["discover", "--base", "linear", "--quiet", "--out"])
@@ -319,8 +331,8 @@ fn multiarm_discover_command_names_dry_friction() {
 }
 
 /// The MultiArm campaign with its roles set per run (the rest as in [`campaign_toml`]).
-fn campaign_with_roles(data: &Path, small: &str, large: &str) -> String {
-    campaign_toml(data)
+fn campaign_with_roles(small: &str, large: &str) -> String {
+    campaign_toml()
         .replace("role = \"identify\"\n", "")
         .replace(
             "id = \"small\"\n",
@@ -369,8 +381,7 @@ fn multiarm_identify_free_decay() {
         Path::new(env!("CARGO_MANIFEST_DIR")).join("campaigns/multiarm")
     } else {
         let c = tmp.path().join("campaign");
-        std::fs::create_dir_all(&c).expect("campaign dir");
-        std::fs::write(c.join("campaign.toml"), campaign_toml(&data)).expect("write campaign");
+        write_campaign(&c, &data, &campaign_toml());
         c
     };
 
@@ -425,12 +436,7 @@ fn multiarm_identify_free_decay() {
 
     // --- The small decay alone (the large one validates): its dry friction. ---
     let split = tmp.path().join("split");
-    std::fs::create_dir_all(&split).expect("split dir");
-    std::fs::write(
-        split.join("campaign.toml"),
-        campaign_with_roles(&data, "identify", "validate"),
-    )
-    .expect("write campaign");
+    write_campaign(&split, &data, &campaign_with_roles("identify", "validate"));
     let out = tmp.path().join("small");
     pendulum(&["identify", "--quiet", "--out"], &[&out, &split]);
     let params = out.join("params.parquet");
@@ -492,12 +498,7 @@ fn multiarm_identify_free_decay() {
 
     // --- `pendulum validate` with the joint fit's params on both decays. ---
     let val = tmp.path().join("val");
-    std::fs::create_dir_all(&val).expect("val dir");
-    std::fs::write(
-        val.join("campaign.toml"),
-        campaign_with_roles(&data, "validate", "validate"),
-    )
-    .expect("write campaign");
+    write_campaign(&val, &data, &campaign_with_roles("validate", "validate"));
     let vout = tmp.path().join("vout");
     let text = pendulum(
         &["validate", "--params"],

@@ -2,6 +2,7 @@
 
 mod cli;
 mod discover;
+mod hostile;
 mod identify;
 mod independent;
 mod ingest;

@@ -15,6 +15,7 @@ use pendulum_maps::params_file::load_model;
 use pendulum_maps::{IcSpec, MapsError, Sweep};
 use pendulum_model::{ClassifyOptions, Dimensionless, ParamSpec, Physical, SimOptions};
 
+use crate::inputs::Inputs;
 use crate::JobError;
 
 impl From<MapsError> for JobError {
@@ -407,6 +408,18 @@ pub fn run(a: &BifurcateArgs) -> Result<BifurcateSummary, JobError> {
     cfg.classify = ClassifyOptions::default();
     cfg.threads = a.run.threads;
     cfg.validate()?;
+    // Before the sweep: none of the outputs may replace the --params file.
+    let mut inputs = Inputs::new();
+    if let Some(p) = &a.model.params_file {
+        inputs.add("--params", p);
+    }
+    for name in [
+        "bifurcation.parquet",
+        "bifurcation.png",
+        "bifurcation_classes.png",
+    ] {
+        inputs.check_output("the output", &a.out.join(name))?;
+    }
     create_dir(&a.out)?;
     let bar = progress_bar(cfg.tasks(), "bifurcate", !a.run.quiet);
     let t = Instant::now();

@@ -7,11 +7,12 @@ use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressStyle};
 use pendulum_fit::StopRule;
-use pendulum_process::identify::{residual_series, FitOutcome, ResidualSeries, RunFit};
+use pendulum_process::identify::{residual_series, FitOutcome, ResidualSeries, RunFit, MIN_NP};
 use pendulum_process::pipeline::{Context, PipelineConfig, StageConfig};
 use pendulum_process::{Role, RunData};
 
-use crate::outputs::{write_outputs, OutputSummary};
+use crate::inputs::Inputs;
+use crate::outputs::{write_outputs_checked, OutputSummary, TABLES};
 use crate::runs::load_runs;
 use crate::JobError;
 
@@ -195,6 +196,11 @@ pub fn run(job: &IdentifyJob) -> Result<OutputSummary, JobError> {
     let (mut pipeline, _) = load_pipeline(job.pipeline.as_deref(), IDENTIFY_PIPELINE, "identify")?;
     apply_overrides(&mut pipeline, &job.overrides);
     let pipeline_text = serde_json::to_string(&pipeline).unwrap_or_default();
+    let mut inputs = Inputs::new();
+    if let Some(p) = &job.pipeline {
+        inputs.add("--pipeline", p);
+    }
+    let inputs = checked_inputs(inputs, &job.input, &job.out)?;
     let runs: Vec<RunData> = load_runs(&job.input)?;
     if !runs.iter().any(|r| r.role == Role::Identify) {
         return Err(JobError::Invalid(format!(
@@ -203,6 +209,21 @@ pub fn run(job: &IdentifyJob) -> Result<OutputSummary, JobError> {
         )));
     }
     let mut ctx = Context::new(runs);
+    // The fit silently runs with at least MIN_NP members: say so, naming where np came from.
+    if let Some(np) = pipeline
+        .fit_mut()
+        .and_then(|f| f.np)
+        .filter(|&n| n < MIN_NP)
+    {
+        let from = if job.overrides.np.is_some() {
+            format!("--np {np}")
+        } else {
+            format!("the pipeline's np = {np}")
+        };
+        ctx.notes.push(format!(
+            "{from} raised to {MIN_NP}: differential evolution needs at least {MIN_NP} members"
+        ));
+    }
     let max_gen = pipeline.fit_mut().map_or(0, |f| f.max_generations);
     let bar = if job.progress {
         let (bar, f) = generation_bar(max_gen);
@@ -216,12 +237,13 @@ pub fn run(job: &IdentifyJob) -> Result<OutputSummary, JobError> {
         b.finish_and_clear();
     }
     res?;
-    let mut summary = write_outputs(
+    let mut summary = write_outputs_checked(
         &ctx,
         &job.out,
         &pipeline_text,
         "pendulum identify",
         started.elapsed().as_secs_f64(),
+        &inputs,
     )?;
     if job.free_segments {
         let free = free_segment_runs(&ctx);
@@ -234,12 +256,13 @@ pub fn run(job: &IdentifyJob) -> Result<OutputSummary, JobError> {
         let n = free.len();
         let mut fctx = Context::new(free);
         pipeline.run(&mut fctx)?;
-        let fs = write_outputs(
+        let fs = write_outputs_checked(
             &fctx,
             &job.out.join("free_segments"),
             &pipeline_text,
             "pendulum identify --free-segments",
             started.elapsed().as_secs_f64(),
+            &inputs,
         )?;
         summary.text += &format!(
             "\nfree segments before the shaker starts ({n} runs), fitted as free decays:\n{fs}"
@@ -266,6 +289,12 @@ pub fn validate(job: &ValidateJob) -> Result<OutputSummary, JobError> {
     let (pipeline, _) = load_pipeline(job.pipeline.as_deref(), VALIDATE_PIPELINE, "validate")?;
     let pipeline_text = serde_json::to_string(&pipeline).unwrap_or_default();
     let given = crate::outputs::read_params(&job.params, job.model.as_deref())?;
+    let mut inputs = Inputs::new();
+    inputs.add("--params", &job.params);
+    if let Some(p) = &job.pipeline {
+        inputs.add("--pipeline", p);
+    }
+    let inputs = checked_inputs(inputs, &job.input, &job.out)?;
     let runs = load_runs(&job.input)?;
     if !runs.iter().any(|r| r.role == Role::Validate) {
         return Err(JobError::Invalid(format!(
@@ -276,11 +305,23 @@ pub fn validate(job: &ValidateJob) -> Result<OutputSummary, JobError> {
     let mut ctx = Context::new(runs);
     ctx.given = Some(given);
     pipeline.run(&mut ctx)?;
-    write_outputs(
+    write_outputs_checked(
         &ctx,
         &job.out,
         &pipeline_text,
         "pendulum validate",
         started.elapsed().as_secs_f64(),
+        &inputs,
     )
+}
+
+/// `inputs` plus the files of the run source `input`, after checking that none of the tables
+/// `out` will receive is one of them: refused before the fit rather than after it. (Plots are
+/// named after models and runs and checked as they are written.)
+fn checked_inputs(mut inputs: Inputs, input: &Path, out: &Path) -> Result<Inputs, JobError> {
+    inputs.add_run_source(input)?;
+    for t in TABLES {
+        inputs.check_output("the output", &out.join(t))?;
+    }
+    Ok(inputs)
 }

@@ -11,6 +11,7 @@ use pendulum_log::{
 use pendulum_rig::{Campaign, CaptureReader, IngestStats, Location, ReadOptions, RunSpec, Sample};
 use rayon::prelude::*;
 
+use crate::inputs::Inputs;
 use crate::runs::run_metadata;
 use crate::JobError;
 
@@ -42,7 +43,13 @@ impl IngestSummary {
 
 impl std::fmt::Display for IngestSummary {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        writeln!(f, "campaign {}: {} runs", self.campaign, self.rows.len())?;
+        // The name comes from campaign.toml: printed with any terminal code escaped.
+        writeln!(
+            f,
+            "campaign {}: {} runs",
+            pendulum_rig::names::printable(&self.campaign),
+            self.rows.len()
+        )?;
         writeln!(
             f,
             "{:<10} {:<10} {:>9} {:>8} {:>8} {:>8} {:>5} {:>6} {:>6} {:>6}",
@@ -178,7 +185,7 @@ fn ingest_run(c: &Campaign, spec: &RunSpec, out_dir: &Path) -> Result<IngestRow,
         },
         None => None,
     };
-    let path = out_dir.join(format!("{}.mcap", spec.id));
+    let path = mcap_path(out_dir, spec);
     let mut w = RunLogOptions::new()
         .library(concat!("pendulum/", env!("CARGO_PKG_VERSION")))
         .start_ns(start_ns)
@@ -231,9 +238,24 @@ fn ingest_run(c: &Campaign, spec: &RunSpec, out_dir: &Path) -> Result<IngestRow,
     })
 }
 
+/// Where a run's MCAP goes (the id is a safe file name: [`pendulum_rig::names`]).
+fn mcap_path(out_dir: &Path, spec: &RunSpec) -> PathBuf {
+    out_dir.join(format!("{}.mcap", spec.id))
+}
+
 /// Ingests every run of the campaign at `dir` into `out_dir`.
 pub fn run(dir: &Path, out_dir: &Path, show_progress: bool) -> Result<IngestSummary, JobError> {
     let c = Campaign::load(dir)?;
+    // OUT may be the campaign folder itself: no `<id>.mcap` may replace campaign.toml or a
+    // capture. Checked for every run before anything is written.
+    let mut inputs = Inputs::new();
+    inputs.add_campaign(&c, dir);
+    for spec in &c.runs {
+        inputs.check_output(
+            &format!("the output of run {}", spec.id),
+            &mcap_path(out_dir, spec),
+        )?;
+    }
     std::fs::create_dir_all(out_dir).map_err(|source| JobError::Io {
         path: out_dir.to_path_buf(),
         source,
@@ -252,7 +274,7 @@ pub fn run(dir: &Path, out_dir: &Path, show_progress: bool) -> Result<IngestSumm
         .runs
         .par_iter()
         .map(|spec| {
-            let row = if !spec.file.is_file() {
+            let mut row = if !spec.file.is_file() {
                 IngestRow {
                     run_id: spec.id.clone(),
                     format: "-".into(),
@@ -271,9 +293,18 @@ pub fn run(dir: &Path, out_dir: &Path, show_progress: bool) -> Result<IngestSumm
                     warnings: Vec::new(),
                 })
             };
-            if row.error.is_some() {
-                // A stale <id>.mcap from an earlier ingest would make the folder look complete.
-                let _ = std::fs::remove_file(out_dir.join(format!("{}.mcap", spec.id)));
+            // A failed run's own temporary file is gone (the writer removes it). An `<id>.mcap`
+            // already in OUT is not this process's to delete: it may be an earlier ingest's, or
+            // another ingest's finishing right now into the same folder. The failure says it is
+            // there and stale instead.
+            if let Some(e) = &mut row.error {
+                let earlier = mcap_path(out_dir, spec);
+                if earlier.exists() {
+                    e.push_str(&format!(
+                        "; {} is NOT from this ingest (left as it was)",
+                        earlier.display()
+                    ));
+                }
             }
             bar.set_message(spec.id.clone());
             bar.inc(1);

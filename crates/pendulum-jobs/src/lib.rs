@@ -7,6 +7,7 @@ pub mod demo;
 pub mod discover;
 pub mod identify;
 pub mod ingest;
+pub mod inputs;
 pub mod outputs;
 pub mod replay;
 pub mod runs;
@@ -36,6 +37,19 @@ pub enum JobError {
         path: PathBuf,
         #[source]
         source: std::io::Error,
+    },
+    /// An output path names one of the command's input files (see [`inputs`]).
+    #[error(
+        "{}: {what_output} is the same file as {what_input} {}: refusing to overwrite an input; \
+         choose another output path",
+        .output.display(),
+        .input.display()
+    )]
+    OutputIsInput {
+        output: PathBuf,
+        what_output: String,
+        input: PathBuf,
+        what_input: String,
     },
     #[error("{0}")]
     Invalid(String),

@@ -20,6 +20,7 @@ use pendulum_process::{RigParams, Role};
 use pendulum_report::{Column, ColumnData, TableOptions};
 
 use crate::identify::residuals_of;
+use crate::inputs::Inputs;
 use crate::JobError;
 
 /// What was written, and a printable summary.
@@ -354,6 +355,24 @@ pub fn models_of(ctx: &Context) -> Vec<FitOutcome> {
     }
 }
 
+/// `out/name` for a file name built from a model name and a run id. `validate` reads the model
+/// name from a params.parquet and the run ids may come from MCAP metadata: whoever wrote those
+/// files must not be able to place a plot outside `out` (a name like `../../x`).
+///
+/// Nor may a plot replace one of the command's input files.
+fn out_file(out: &Path, name: &str, inputs: &Inputs) -> Result<PathBuf, JobError> {
+    pendulum_rig::names::check_file_name(name).map_err(|problem| {
+        JobError::Invalid(format!(
+            "{}: refusing to write the plot {name:?}: the name (built from a model name and a \
+             run id read from the input) {problem}",
+            out.display()
+        ))
+    })?;
+    let path = out.join(name);
+    inputs.check_output("the output", &path)?;
+    Ok(path)
+}
+
 /// Writes every table and plot for the context's results into `out`.
 pub fn write_outputs(
     ctx: &Context,
@@ -361,6 +380,29 @@ pub fn write_outputs(
     pipeline: &str,
     command: &str,
     wall_s: f64,
+) -> Result<OutputSummary, JobError> {
+    write_outputs_checked(ctx, out, pipeline, command, wall_s, &Inputs::new())
+}
+
+/// The tables `write_outputs` writes whatever the results (plots are named after models and
+/// runs): a command checks them against its inputs before a long fit.
+pub const TABLES: [&str; 5] = [
+    "params.parquet",
+    "runs.parquet",
+    "initial_conditions.parquet",
+    "convergence.parquet",
+    "residuals.parquet",
+];
+
+/// [`write_outputs`], refusing (before writing it) any table or plot that would replace one of
+/// the command's `inputs`.
+pub fn write_outputs_checked(
+    ctx: &Context,
+    out: &Path,
+    pipeline: &str,
+    command: &str,
+    wall_s: f64,
+    inputs: &Inputs,
 ) -> Result<OutputSummary, JobError> {
     std::fs::create_dir_all(out).map_err(|source| JobError::Io {
         path: out.to_path_buf(),
@@ -384,6 +426,7 @@ pub fn write_outputs(
                  column not_separable",
             );
         }
+        inputs.check_output("the output", &p)?;
         o.write(&p, &params_columns(ctx, &models))?;
         tables.push(p);
     }
@@ -497,6 +540,7 @@ pub fn write_outputs(
             ),
         ));
         let p = out.join("runs.parquet");
+        inputs.check_output("the output", &p)?;
         opts.clone()
             .meta(
                 "simulated_model",
@@ -562,11 +606,11 @@ pub fn write_outputs(
                     col.push(x);
                 }
             }
-            let png = out.join(format!(
-                "history_{}_{}.png",
-                m.spec.name.replace('+', "_"),
-                id
-            ));
+            let png = out_file(
+                out,
+                &format!("history_{}_{}.png", m.spec.name.replace('+', "_"), id),
+                inputs,
+            )?;
             let x_label = if m.spec.is_free_decay() {
                 "time from the first turning point (s)"
             } else {
@@ -576,7 +620,11 @@ pub fn write_outputs(
             plots.push(png);
         }
         if m.convergence.len() > 1 {
-            let png = out.join(format!("convergence_{}.png", m.spec.name.replace('+', "_")));
+            let png = out_file(
+                out,
+                &format!("convergence_{}.png", m.spec.name.replace('+', "_")),
+                inputs,
+            )?;
             convergence_plot(&png, m)?;
             plots.push(png);
         }
@@ -599,6 +647,7 @@ pub fn write_outputs(
         {
             cols.push(f64s(n, u, v));
         }
+        inputs.check_output("the output", &p)?;
         opts.write(&p, &cols)?;
         tables.push(p);
     }
@@ -608,6 +657,7 @@ pub fn write_outputs(
         for (n, v) in ["best", "worst", "mean"].iter().zip(cvv) {
             cols.push(f64s(n, "rad", v));
         }
+        inputs.check_output("the output", &p)?;
         opts.write(&p, &cols)?;
         tables.push(p);
     }
@@ -630,6 +680,7 @@ pub fn write_outputs(
         for ((n, u), v) in names.iter().zip(rsv) {
             cols.push(f64s(n, u, v));
         }
+        inputs.check_output("the output", &p)?;
         opts.write(&p, &cols)?;
         tables.push(p);
     }
@@ -781,4 +832,29 @@ fn convergence_plot(path: &Path, m: &FitOutcome) -> Result<(), JobError> {
     };
     fig.save_png(path)?;
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A model name read from someone's params.parquet (validate) cannot place a plot outside
+    /// the output folder.
+    #[test]
+    fn issue_13_plot_names_from_inputs_stay_in_out() {
+        let out = Path::new("/data/out");
+        assert_eq!(
+            out_file(out, "history_reference_r01.png", &Inputs::new()).unwrap(),
+            out.join("history_reference_r01.png")
+        );
+        for name in [
+            "history_../../x_r01.png",
+            "history_/etc/cron.d/x_r01.png",
+            "history_a\u{1b}[2J_r01.png",
+        ] {
+            let e = out_file(out, name, &Inputs::new()).unwrap_err().to_string();
+            assert!(e.contains("refusing to write the plot"), "{e}");
+            assert!(!e.contains('\u{1b}'), "{e:?}");
+        }
+    }
 }

@@ -21,6 +21,7 @@ use pendulum_model::{integrate, Model, ParamSpec, Physical, SimOptions};
 use pendulum_process::ic::{estimate_state, IcConfig};
 use pendulum_process::{align, AlignConfig};
 
+use crate::inputs::Inputs;
 use crate::runs::run_data_from_log;
 use crate::JobError;
 
@@ -106,6 +107,12 @@ pub fn run(a: &ReplayArgs) -> Result<ReplaySummary, JobError> {
             )));
         }
     }
+    // Checked before anything is read or simulated: the output replaces its target by rename,
+    // so `--out` equal to `--params` (or to RUN) would silently destroy that input.
+    let mut inputs = Inputs::new();
+    inputs.add("RUN", &a.run);
+    inputs.add("--params", &a.params_file);
+    inputs.check_output("--out", &a.out)?;
     let log = read_run(&a.run)?;
     let rd = run_data_from_log(&log)?;
     if rd.enc_t_s.is_empty() {

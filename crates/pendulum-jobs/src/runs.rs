@@ -151,11 +151,24 @@ pub fn run_data_from_log(log: &RunLog) -> Result<RunData, JobError> {
             )))
         }
     };
+    // The id names output files (`history_<model>_<id>.png`) and an MCAP may come from anyone:
+    // the same rule as a campaign's ids. Without an id, the file's stem (already a name).
+    let id = match m.get("id") {
+        Some(id) => id.clone(),
+        None => path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default(),
+    };
+    pendulum_rig::names::check_run_id(&id).map_err(|problem| {
+        JobError::Invalid(format!(
+            "{}: metadata `run.id` = {id:?} {problem}: expected {}",
+            path.display(),
+            pendulum_rig::names::ID_EXPECTED
+        ))
+    })?;
     Ok(RunData {
-        id: m
-            .get("id")
-            .cloned()
-            .unwrap_or_else(|| path.display().to_string()),
+        id,
         role,
         rig: RigParams {
             m_kg: meta_f64(m, "m_kg", path)?,

@@ -13,6 +13,7 @@ use crate::bifurcate::{
     create_dir, fmt_ranges, progress_bar, resolve_assignments, runs_of, IcArgs, ModelArgs,
     ResolvedModel, RunArgs, Study,
 };
+use crate::inputs::Inputs;
 use crate::JobError;
 
 /// `pendulum zones` options.
@@ -245,6 +246,20 @@ pub fn run(a: &ZonesArgs) -> Result<ZonesSummary, JobError> {
     cfg.record_periods = a.run.record;
     cfg.sim = a.run.sim()?;
     cfg.threads = a.run.threads;
+    // Before the maps: none of the outputs may replace the --params file.
+    let mut inputs = Inputs::new();
+    if let Some(p) = &a.model.params_file {
+        inputs.add("--params", p);
+    }
+    let mut outputs = vec!["zones.parquet".to_string(), "zones_compare.png".to_string()];
+    outputs.extend(
+        models
+            .iter()
+            .map(|m| format!("zones_{}.png", slug(&m.label))),
+    );
+    for name in outputs {
+        inputs.check_output("the output", &a.out.join(name))?;
+    }
     run_models(&models, &cfg, &ics.describe(), &a.out, !a.run.quiet, &[])
 }
 

@@ -4,6 +4,7 @@ use std::collections::BTreeMap;
 use std::fs::{self, File};
 use std::io::BufWriter;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
 
 use mcap::records::{MessageHeader, Metadata};
 use serde::Serialize;
@@ -113,10 +114,16 @@ impl RunLogOptions {
 
     /// Starts writing a run whose file will be `final_path`.
     ///
-    /// The data goes to a temporary `.NAME.tmp` in the same folder (same file system, so the
-    /// final rename is atomic; dot-prefixed, so dataset globs skip it). `final_path` appears only
-    /// when [`RunLogWriter::finish`] succeeds, replacing any previous file of that name.
+    /// The data goes to a temporary `.NAME.<pid>-<n>.tmp` in the same folder (same file system,
+    /// so the final rename is atomic; dot-prefixed, so dataset globs skip it). `final_path`
+    /// appears only when [`RunLogWriter::finish`] succeeds, replacing any previous file of that
+    /// name.
+    ///
+    /// The temporary name is unique to this process and writer, and created only if it does not
+    /// exist yet: two processes writing the same run into one folder must not share (truncate,
+    /// rename away or delete) each other's temporary file (issue 13).
     pub fn create(&self, final_path: &Path) -> Result<RunLogWriter, LogError> {
+        static COUNTER: AtomicU64 = AtomicU64::new(0);
         let file_name = final_path
             .file_name()
             .ok_or_else(|| LogError::InvalidPath {
@@ -124,10 +131,14 @@ impl RunLogOptions {
             })?;
         let mut tmp_name = std::ffi::OsString::from(".");
         tmp_name.push(file_name);
-        tmp_name.push(".tmp");
+        tmp_name.push(format!(
+            ".{}-{}.tmp",
+            std::process::id(),
+            COUNTER.fetch_add(1, Ordering::Relaxed)
+        ));
         let tmp_path = final_path.with_file_name(tmp_name);
 
-        let file = File::create(&tmp_path).map_err(|source| LogError::Io {
+        let file = File::create_new(&tmp_path).map_err(|source| LogError::Io {
             path: tmp_path.clone(),
             op: "create the temporary file",
             source,

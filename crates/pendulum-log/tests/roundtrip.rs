@@ -295,6 +295,39 @@ fn bad_values_are_rejected_with_structure() {
     ));
 }
 
+/// Two writers of the same run in one folder (two `pendulum ingest` into one --out, script 06
+/// of issue 13): each has its own temporary file, so one failing (dropped) neither deletes nor
+/// truncates the other's, and the survivor's finish still renames its own file into place.
+/// Before, both used `.r01.mcap.tmp`: the drop deleted the other's data and its finish failed.
+#[test]
+fn issue_13_two_writers_of_one_run_keep_their_own_temporary_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("r01.mcap");
+    let fx = fixture(100, 0);
+    let mut a = RunLogOptions::new().create(&path).unwrap();
+    let mut b = RunLogOptions::new().create(&path).unwrap();
+    assert_ne!(a.tmp_path(), b.tmp_path());
+    for m in &fx.encoder {
+        a.write_encoder(m).unwrap();
+        b.write_encoder(m).unwrap();
+    }
+    let b_tmp = b.tmp_path().to_path_buf();
+    drop(a); // fails half-way
+    assert!(
+        b_tmp.exists(),
+        "the other writer's temporary file was deleted"
+    );
+    let summary = b.finish().unwrap();
+    assert_eq!(summary.messages["/encoder"], 100);
+    let back = read_run(&path).unwrap();
+    assert_eq!(back.encoder.len(), 100);
+    let names: Vec<String> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    assert_eq!(names, ["r01.mcap"]);
+}
+
 #[test]
 fn dropped_writer_leaves_nothing_and_keeps_the_previous_file() {
     let dir = tempfile::tempdir().unwrap();
@@ -304,7 +337,16 @@ fn dropped_writer_leaves_nothing_and_keeps_the_previous_file() {
     {
         let mut w = RunLogOptions::new().create(&path).unwrap();
         assert!(w.tmp_path().exists());
-        assert_eq!(w.tmp_path().file_name().unwrap(), ".r01.mcap.tmp");
+        let tmp_name = w
+            .tmp_path()
+            .file_name()
+            .unwrap()
+            .to_string_lossy()
+            .into_owned();
+        assert!(
+            tmp_name.starts_with(".r01.mcap.") && tmp_name.ends_with(".tmp"),
+            "{tmp_name}"
+        );
         for m in &fx.encoder {
             w.write_encoder(m).unwrap();
         }

@@ -286,6 +286,10 @@ impl RunFit {
     }
 }
 
+/// The smallest DE population the fit runs with (differential evolution's mutation draws three
+/// members besides the target); a smaller `np` is raised to it.
+pub const MIN_NP: usize = 4;
+
 /// A fitted model.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct FitOutcome {
@@ -351,7 +355,7 @@ pub fn identify(
         order: Default::default(),
     };
     let dim = spec.params.len() + 2 * runs.len();
-    let np = cfg.np.unwrap_or(10 * dim).max(4);
+    let np = cfg.np.unwrap_or(10 * dim).max(MIN_NP);
     let de = DeConfig {
         np,
         f: cfg.f,

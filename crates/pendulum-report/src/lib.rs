@@ -1,11 +1,12 @@
 //! Parquet tables for dataframe analysis (pandas, polars, DuckDB): typed columns, units in field
 //! metadata, the producing command and versions in the key-value metadata, zstd, written
-//! atomically (a `.name.tmp` beside the target, fsync, rename) so a crash never leaves a
+//! atomically (a `.name.<pid>-<n>.tmp` beside the target, fsync, rename) so a crash never leaves a
 //! half-written table under the final name.
 
 use std::collections::HashMap;
 use std::fs::File;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 
 use arrow_array::{ArrayRef, BooleanArray, Float64Array, Int64Array, RecordBatch, StringArray};
@@ -145,12 +146,17 @@ pub struct TableSummary {
     pub bytes: u64,
 }
 
+/// `.NAME.<pid>-<n>.tmp` beside `path`: unique to this process and call, so that two processes
+/// writing the same table into one folder never share, truncate or delete each other's
+/// temporary file (issue 13).
 fn tmp_path(path: &Path) -> PathBuf {
+    static COUNTER: AtomicU64 = AtomicU64::new(0);
     let name = path
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_else(|| "table.parquet".into());
-    path.with_file_name(format!(".{name}.tmp"))
+    let n = COUNTER.fetch_add(1, Ordering::Relaxed);
+    path.with_file_name(format!(".{name}.{}-{n}.tmp", std::process::id()))
 }
 
 fn write_table(
@@ -208,7 +214,8 @@ fn write_table(
         path: tmp.clone(),
         source,
     };
-    let file = File::create(&tmp).map_err(io)?;
+    // `create_new`: never truncate a file this call did not create.
+    let file = File::create_new(&tmp).map_err(io)?;
     let pq = |source| ReportError::Parquet {
         path: path.to_path_buf(),
         source,
@@ -248,6 +255,24 @@ mod tests {
     use super::*;
     use parquet::file::reader::{FileReader, SerializedFileReader};
 
+    /// Two writers of one table never share a temporary name (two identify runs into one
+    /// folder, issue 13); before, both used `.t.parquet.tmp`.
+    #[test]
+    fn issue_13_temporary_names_are_unique_per_writer() {
+        let p = Path::new("/out/t.parquet");
+        let (a, b) = (tmp_path(p), tmp_path(p));
+        assert_ne!(a, b);
+        for t in [&a, &b] {
+            let name = t.file_name().unwrap().to_string_lossy().into_owned();
+            assert!(
+                name.starts_with(".t.parquet.") && name.ends_with(".tmp"),
+                "{name}"
+            );
+            assert!(name.contains(&std::process::id().to_string()), "{name}");
+            assert_eq!(t.parent(), p.parent());
+        }
+    }
+
     #[test]
     fn round_trip_with_units_and_metadata() {
         let dir = tempfile::tempdir().unwrap();
@@ -263,7 +288,11 @@ mod tests {
             .write(&path, &cols)
             .unwrap();
         assert_eq!((s.rows, s.columns), (3, 4));
-        assert!(!dir.path().join(".t.parquet.tmp").exists());
+        let left: Vec<_> = std::fs::read_dir(dir.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
+        assert_eq!(left, ["t.parquet"], "temporary file left behind");
         let r = SerializedFileReader::new(File::open(&path).unwrap()).unwrap();
         let kv = r.metadata().file_metadata().key_value_metadata().unwrap();
         assert!(kv

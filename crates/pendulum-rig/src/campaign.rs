@@ -7,6 +7,7 @@ use serde::{Deserialize, Serialize};
 use toml::Value;
 
 use crate::error::RigError;
+use crate::names;
 
 /// The file name of a campaign description inside its folder.
 pub const CAMPAIGN_FILE: &str = "campaign.toml";
@@ -193,13 +194,28 @@ impl Campaign {
             key: key.to_string(),
             expected: expected.to_string(),
         };
+        let unsafe_name =
+            |label: &str, key: &'static str, value: &str, problem: String| RigError::UnsafeName {
+                path: path.to_path_buf(),
+                run: label.to_string(),
+                key,
+                value: value.to_string(),
+                problem,
+            };
         let id = match merged.get("id") {
             Some(Value::String(s)) if !s.is_empty() => s.clone(),
             _ => return Err(key_err(&label, "id", "a non-empty string")),
         };
+        // The id becomes output file names (and appears in messages): refused before it is
+        // used for anything, including as the label of later errors.
+        names::check_run_id(&id).map_err(|p| unsafe_name(&label, "id", &id, p))?;
         label = id.clone();
         let file = match merged.get("file") {
-            Some(Value::String(s)) if !s.is_empty() => dir.join(s),
+            Some(Value::String(s)) if !s.is_empty() => {
+                // Captures are read from the campaign folder only.
+                names::check_relative_file(s).map_err(|p| unsafe_name(&label, "file", s, p))?;
+                dir.join(s)
+            }
             _ => {
                 return Err(key_err(
                     &label,

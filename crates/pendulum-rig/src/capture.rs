@@ -147,9 +147,23 @@ impl Header {
                 return Err(bad(key, "a positive number"));
             }
         }
+        // A tiny positive sensitivity (`1e-320`) turns every raw value into an infinite or
+        // absurd acceleration, which used to surface only as an error about the output MCAP's
+        // field. Any 16-bit accelerometer lies inside this range (±32768 g … ±0.03 g).
+        if let Some(lsb) = self.positive_f64("accel_lsb_per_g") {
+            if !(ACCEL_LSB_PER_G_RANGE.0..=ACCEL_LSB_PER_G_RANGE.1).contains(&lsb) {
+                return Err(bad(
+                    "accel_lsb_per_g",
+                    "a sensitivity from 1 to 1e6 LSB per g (the rig's is 8192)",
+                ));
+            }
+        }
         Ok(())
     }
 }
+
+/// Accepted `accel_lsb_per_g`, inclusive (see [`Header::validate`]).
+pub const ACCEL_LSB_PER_G_RANGE: (f64, f64) = (1.0, 1e6);
 
 /// One encoder reading.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -676,5 +690,27 @@ mod tests {
         let bad = Header::new().with("encoder_cpr", "zero");
         let e = bad.validate(Path::new("f.csv")).unwrap_err().to_string();
         assert!(e.contains("f.csv") && e.contains("encoder_cpr"), "{e}");
+    }
+
+    /// Issue 13, item 10: a sensitivity that makes accelerations infinite or absurd is refused
+    /// naming the capture's header key (it used to fail later naming the output MCAP's field).
+    #[test]
+    fn issue_13_implausible_accel_lsb_per_g_names_the_header_key() {
+        for v in ["1e-320", "1e-300", "0.5", "2e6"] {
+            let h = Header::new().with("accel_lsb_per_g", v);
+            let e = h.validate(Path::new("r01.csv")).unwrap_err().to_string();
+            assert!(
+                e.contains("r01.csv")
+                    && e.contains("header key `accel_lsb_per_g`")
+                    && e.contains(v),
+                "{e}"
+            );
+        }
+        for v in ["1", "8192", "16384", "1e6"] {
+            assert!(Header::new()
+                .with("accel_lsb_per_g", v)
+                .validate(Path::new("f"))
+                .is_ok());
+        }
     }
 }

@@ -46,6 +46,15 @@ impl CaptureReader {
                 Err(e) => return Err(RigError::io(path, e)),
             }
         };
+        if head.is_empty() {
+            // `fill_buf` returns nothing only at the end of the file: say so plainly rather
+            // than list the formats it does not match.
+            return Err(RigError::NotACapture {
+                path: path.to_path_buf(),
+                at: Location::Byte(0),
+                reason: "file is empty (0 bytes)".into(),
+            });
+        }
         if head.starts_with(&SYNC) {
             return Ok(CaptureReader::Sd(SdReader::new(reader, path, opts)?));
         }

@@ -61,6 +61,23 @@ pub enum RigError {
         expected: String,
     },
 
+    /// A run id or `file` key that cannot safely become a file name or a path (see
+    /// [`crate::names`]): the program refuses it rather than read outside the campaign folder
+    /// or write outside the output folder. `value` is printed escaped (`{:?}`), so no control
+    /// character reaches the terminal.
+    #[error("{}: run `{run}`: key `{key}` = {value:?} {problem}: expected {}", .path.display(), crate::names::expected(.key))]
+    UnsafeName {
+        /// The campaign file (or twin case) that holds the value.
+        path: PathBuf,
+        /// The run's id, or `run #N` (1-based) when the id itself is refused.
+        run: String,
+        /// `id` or `file`.
+        key: &'static str,
+        value: String,
+        /// What is wrong with it ("contains a path separator").
+        problem: String,
+    },
+
     /// A run's `role` is neither `identify` nor `validate`.
     #[error("{}: run `{run}`: key `role` = {value:?}: expected \"identify\" or \"validate\"", .path.display())]
     BadRole {

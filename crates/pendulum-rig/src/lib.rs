@@ -10,6 +10,7 @@ pub mod crc8;
 pub mod detect;
 pub mod error;
 mod lines;
+pub mod names;
 pub mod sd;
 pub mod serial;
 

@@ -467,10 +467,13 @@ impl<R: BufRead> TimeseriesReader<R> {
     fn read_header(&mut self) -> Result<u64, RigError> {
         loop {
             let Some(info) = self.read_line()? else {
-                return Err(self.not_a_capture(
-                    self.line_no.max(1),
-                    "the file ends before its column-name line".into(),
-                ));
+                // No line at all: the file is empty, which is the message a user needs.
+                let reason = if self.line_no == 0 {
+                    "file is empty (0 bytes)"
+                } else {
+                    "the file ends before its column-name line"
+                };
+                return Err(self.not_a_capture(self.line_no.max(1), reason.into()));
             };
             if info.overlong {
                 return Err(self.not_a_capture(
