@@ -229,26 +229,7 @@ fn weighted_se(
     if p == 0 || n <= p {
         return None;
     }
-    let scale: Vec<f64> = (0..p)
-        .map(|i| {
-            (rows
-                .iter()
-                .map(|r| r.weight * col(r, i).powi(2))
-                .sum::<f64>()
-                / n as f64)
-                .sqrt()
-                .max(1e-300)
-        })
-        .collect();
-    let mut ata = vec![0.0; p * p];
-    for r in rows {
-        let v: Vec<f64> = (0..p).map(|i| col(r, i) / scale[i]).collect();
-        for i in 0..p {
-            for k in 0..p {
-                ata[i * p + k] += r.weight * v[i] * v[k];
-            }
-        }
-    }
+    let (scale, ata, _) = normal_equations(rows, p, col);
     let inv = inverse(&ata, p)?;
     let s2 = rss / (n - p) as f64;
     Some(
@@ -258,22 +239,21 @@ fn weighted_se(
     )
 }
 
-/// One weighted least-squares solve with the dynamics columns divided by 1 + J/I_r for a given
-/// J (columns are scaled for conditioning). `rss` is the weighted sum of squares.
-fn ols_at(rows: &[WeakRow], columns: &[usize], inertia_kg_m2: f64) -> Option<Ols> {
-    let p = columns.len();
-    let n = rows.iter().filter(|r| r.weight > 0.0).count();
-    if n <= p + 2 {
-        return None;
-    }
-    let col = |r: &WeakRow, i: usize| design(r, columns[i], inertia_kg_m2);
+/// The weighted normal equations AᵀWA, AᵀWb of a design given by `col(row, i)`, each column
+/// scaled to unit weighted RMS for conditioning (the scales are returned).
+fn normal_equations(
+    rows: &[WeakRow],
+    p: usize,
+    col: &dyn Fn(&WeakRow, usize) -> f64,
+) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+    let n = rows.iter().filter(|r| r.weight > 0.0).count().max(1) as f64;
     let scale: Vec<f64> = (0..p)
         .map(|i| {
             (rows
                 .iter()
                 .map(|r| r.weight * col(r, i).powi(2))
                 .sum::<f64>()
-                / n as f64)
+                / n)
                 .sqrt()
                 .max(1e-300)
         })
@@ -289,6 +269,19 @@ fn ols_at(rows: &[WeakRow], columns: &[usize], inertia_kg_m2: f64) -> Option<Ols
             }
         }
     }
+    (scale, ata, atb)
+}
+
+/// One weighted least-squares solve with the dynamics columns divided by 1 + J/I_r for a given
+/// J (columns are scaled for conditioning). `rss` is the weighted sum of squares.
+fn ols_at(rows: &[WeakRow], columns: &[usize], inertia_kg_m2: f64) -> Option<Ols> {
+    let p = columns.len();
+    let n = rows.iter().filter(|r| r.weight > 0.0).count();
+    if n <= p + 2 {
+        return None;
+    }
+    let col = |r: &WeakRow, i: usize| design(r, columns[i], inertia_kg_m2);
+    let (scale, ata, atb) = normal_equations(rows, p, &col);
     let beta = if p == 0 {
         Vec::new()
     } else {
