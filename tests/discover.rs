@@ -273,7 +273,7 @@ fn regression_issue_5_finds_speed_drift() {
 /// Survey (slow, by hand with `--ignored`): campaigns with nothing hidden, drawn damping and
 /// seeds; prints what (if anything) each names. The false-alarm rate in the issue 5 note.
 #[test]
-#[ignore = "survey for the issue 5 note: SURVEY_N campaigns (default 8), ~20 s each"]
+#[ignore = "survey for issue 12: SURVEY_N nothing-hidden drawn designs (default 8); SURVEY_N=50 is ~20 minutes"]
 fn survey_issue_5_false_alarm_rate() {
     let n: u64 = std::env::var("SURVEY_N")
         .ok()
@@ -294,8 +294,9 @@ fn survey_issue_5_false_alarm_rate() {
         );
     }
     eprintln!("survey: false alarms in {alarms} of {n}; `unexplained` in {unexplained} of {n}");
+    // Issue 12's bar: at most 1 of 50 nothing-hidden campaigns names anything.
     assert!(
-        alarms as f64 <= (n as f64 / 8.0).ceil(),
+        alarms as f64 <= (n as f64 / 50.0).ceil(),
         "false alarms in {alarms} of {n}"
     );
 }
@@ -447,7 +448,7 @@ fn draw(effect: &str, r: &mut rand_chacha::ChaCha8Rng) -> (f64, String, Base, f6
 /// `SURVEY_N` times (default 3) with drawn sizes and fresh seeds, then pairs; prints one line per
 /// campaign (named alone? estimate error; `unexplained`?) and the hit rate. For the issue 5 note.
 #[test]
-#[ignore = "survey for the issue 5 note: 12 effects × SURVEY_N campaigns + pairs, ~10 minutes"]
+#[ignore = "survey for issue 12: 12 effects × SURVEY_N (default 3) drawn designs + 4 pairs; SURVEY_N=5 is ~30 minutes"]
 fn survey_issue_5_every_effect() {
     let n: u64 = std::env::var("SURVEY_N")
         .ok()
@@ -481,11 +482,8 @@ fn survey_issue_5_every_effect() {
             let accepted = s.discovery.accepted();
             let row = s.discovery.rows.iter().find(|r| r.effect == *effect);
             let est = row.map_or(f64::NAN, |r| r.estimate);
-            let ok_est = if *effect == "encoder_offset" {
-                (est - truth).abs() <= 0.01
-            } else {
-                (est - truth).abs() <= 0.25 * truth.abs()
-            };
+            // Issue 12's bar: named alone, estimate within 10 % of the truth.
+            let ok_est = (est - truth).abs() <= 0.10 * truth.abs();
             let hit = accepted == [*effect];
             hits += usize::from(hit);
             within += usize::from(hit && ok_est);
@@ -500,7 +498,7 @@ fn survey_issue_5_every_effect() {
             );
         }
     }
-    eprintln!("survey-every: named alone in {hits} of {total}; of those within tolerance {within}");
+    eprintln!("survey-every: named alone in {hits} of {total}; of those within 10 % {within}");
     // Pairs: both named, nothing else.
     let pairs = [
         ("coulomb_constant", "position_torque"),
@@ -543,4 +541,141 @@ fn survey_issue_5_every_effect() {
         "survey-pair: both named (and nothing else) in {pair_hits} of {}",
         pairs.len()
     );
+    assert_eq!(
+        within, total,
+        "issue 12: every effect hidden alone must be named alone within 10 %"
+    );
+}
+
+/// A free-decay campaign (no shaker, `format = "timeseries"`) written from the model's own
+/// simulator over drawn designs: per run a bob of rig.md (mass, length), a hand start (a swing of
+/// 0.8–2.5 rad either way), 20–30 s at 200 Hz, the angle as 4096-count encoder readings (rig.md's
+/// encoder) stamped with ±20 µs jitter. Bearing friction μ (r_b = 12.25 mm) and viscous drag b
+/// act in every run. Returns each run's dimensionless β = b/(m ω0) for the truth.
+fn free_decay_campaign(dir: &Path, seed: u64, b: f64, mu: f64) -> Vec<f64> {
+    use pendulum_model::{Model, Physical, SimOptions};
+    use pendulum_rig::twin::{BOB_LENGTH_RANGE_M, BOB_MASSES_KG};
+    let mut r = rng(seed);
+    std::fs::create_dir_all(dir).unwrap();
+    let mut toml = format!(
+        "name = \"free-decays-{seed}\"\n[rig]\nformat = \"timeseries\"\ntime_column = \"t_s\"\nangle_column = \"count\"\nangle_unit = \"counts\"\ncounts_per_rev = 4096\nhanging_angle = 0\nr_b_m = 0.01225\nrole = \"identify\"\n"
+    );
+    let mut betas = Vec::new();
+    for k in 0..3 {
+        let phys = Physical {
+            m_kg: BOB_MASSES_KG[r.random_range(0..BOB_MASSES_KG.len())],
+            l_m: r.random_range(BOB_LENGTH_RANGE_M.0..BOB_LENGTH_RANGE_M.1),
+            crank_r_m: 0.0,
+            r_b_m: 0.01225,
+            a_kg_m: 0.0,
+            b_n_s_m: b,
+            mu,
+            ..Physical::default()
+        };
+        let w0 = phys.omega0_rad_s();
+        let theta0 = r.random_range(0.8..2.5) * if r.random::<bool>() { 1.0 } else { -1.0 };
+        let duration_s = r.random_range(20.0..30.0);
+        let model = Model::new(phys.to_dimensionless());
+        let tr = pendulum_model::sim::simulate(
+            &model,
+            &SimOptions::default(),
+            [theta0, 0.0],
+            0.0,
+            duration_s * w0,
+            w0 / 200.0,
+        )
+        .unwrap();
+        let mut csv = String::from("t_s,count\n");
+        for (tau, th) in tr.t.iter().zip(&tr.theta) {
+            let stamp = tau / w0 + r.random_range(-20e-6..20e-6);
+            let count = (th * 4096.0 / std::f64::consts::TAU).floor() as i64;
+            csv.push_str(&format!("{stamp:.6},{count}\n"));
+        }
+        let file = format!("decay{k}.csv");
+        std::fs::write(dir.join(&file), csv).unwrap();
+        toml.push_str(&format!(
+            "[[run]]\nid = \"d{k}\"\nfile = \"{file}\"\nm_kg = {}\nl_m = {:.4}\n",
+            phys.m_kg, phys.l_m
+        ));
+        betas.push(phys.to_dimensionless().beta);
+        eprintln!(
+            "free decay d{k}: m {} kg, l {:.4} m, θ0 {theta0:.3} rad, {duration_s:.1} s, β {:.4e}",
+            phys.m_kg,
+            phys.l_m,
+            betas[k]
+        );
+    }
+    std::fs::write(dir.join("campaign.toml"), toml).unwrap();
+    betas
+}
+
+/// Issue 12 item 6: `discover` on a free-decay campaign honours `--base` (dry used to give the
+/// linear answer) and writes the figures and tables a shaker campaign gets. Bearing friction and
+/// viscous drag act together, so the dry base lacks the viscous term (named in every run, β
+/// within 10 %), the linear base lacks the dry one (named), and the reference base lacks nothing
+/// (nothing named).
+#[test]
+fn regression_issue_12_free_decays_honour_base() {
+    let dir = tempfile::tempdir().unwrap();
+    let camp = dir.path().join("campaign");
+    let betas = free_decay_campaign(&camp, 1200, 0.45, 0.15);
+    let run_base = |base: Base| {
+        let s = run(&DiscoverJob {
+            input: camp.clone(),
+            out: dir.path().join(base.name()),
+            base,
+            pipeline: None,
+            generations: None,
+            seed: None,
+            progress: false,
+        })
+        .unwrap();
+        eprintln!("--- base {}\n{s}", base.name());
+        for f in [
+            "diagnosis.parquet",
+            "params.parquet",
+            "runs.parquet",
+            "signatures.parquet",
+            "signatures.png",
+            "envelopes.parquet",
+            "envelopes.png",
+            "report.md",
+        ] {
+            assert!(s.out_dir.join(f).is_file(), "{f} missing");
+        }
+        assert_eq!(s.decays.len(), 3);
+        s
+    };
+    let dry = run_base(Base::Dry);
+    for ((id, d), beta) in dry.decays.iter().zip(&betas) {
+        assert_eq!(d.base.terms, ["coulomb_bearing"], "run {id}");
+        let c = d
+            .candidates
+            .iter()
+            .find(|c| c.term == "viscous_linear" && c.accepted)
+            .unwrap_or_else(|| panic!("run {id}: viscous drag not named on the dry base:\n{d}"));
+        assert!(
+            (c.estimate / beta - 1.0).abs() < 0.10,
+            "run {id}: β {} vs {beta}",
+            c.estimate
+        );
+    }
+    let linear = run_base(Base::Linear);
+    for (id, d) in &linear.decays {
+        assert_eq!(d.base.terms, ["viscous_linear"], "run {id}");
+        assert!(
+            d.accepted
+                .iter()
+                .any(|t| t == "coulomb_bearing" || t == "coulomb_constant"),
+            "run {id}: no dry friction named on the linear base:\n{d}"
+        );
+    }
+    let reference = run_base(Base::Reference);
+    for (id, d) in &reference.decays {
+        assert!(
+            d.accepted.is_empty(),
+            "run {id}: named {:?} with nothing missing",
+            d.accepted
+        );
+    }
 }

@@ -355,7 +355,11 @@ pub fn run(job: &DiscoverJob) -> Result<DiscoverSummary, JobError> {
         write_envelopes(&out.join("envelopes.parquet"), &opts, &envs)?;
         summary.tables.push(out.join("envelopes.parquet"));
         let env_png = out.join("envelopes.png");
-        envelope_plot(&env_png, &envs)?;
+        envelope_plot(
+            &env_png,
+            &envs,
+            "Free-decay segments before the shaker starts",
+        )?;
         summary.plots.push(env_png);
     }
 
@@ -413,7 +417,7 @@ fn free_decays(
     runs: &[pendulum_process::RunData],
     pipeline_json: &str,
 ) -> Result<DiscoverSummary, JobError> {
-    use pendulum_explain::{diagnose_decay, DecayOptions, KnownRig, Term};
+    use pendulum_explain::{diagnose_decay, DecayOptions, KnownRig};
     let out = &job.out;
     std::fs::create_dir_all(out).map_err(|source| JobError::Io {
         path: out.clone(),
@@ -437,18 +441,13 @@ fn free_decays(
             g_m_s2: rd.rig.g_m_s2,
             r_b_m: rd.rig.r_b_m.is_finite().then_some(rd.rig.r_b_m),
         });
-        let mut opts = DecayOptions {
+        let (base, candidates) = decay_terms(job.base);
+        let opts = DecayOptions {
             rig,
+            base,
+            candidates,
             ..DecayOptions::default()
         };
-        if job.base == Base::Reference {
-            opts.base = vec![
-                Term::ViscousLinear,
-                Term::ViscousQuadratic,
-                Term::CoulombBearing,
-            ];
-            opts.candidates = vec![Term::CoulombConstant];
-        }
         let d = diagnose_decay(&rd.enc_t_s, &rd.theta_rad, &opts)
             .map_err(|e| JobError::Invalid(format!("run {}: free-decay analysis: {e}", rd.id)))?;
         let _ = writeln!(text, "=== run {} (free decay) ===\n{d}", rd.id);
@@ -481,6 +480,27 @@ fn free_decays(
         }
         decays.push((rd.id.clone(), d));
     }
+    let envs: Vec<SegmentEnvelope> = runs
+        .iter()
+        .zip(&decays)
+        .map(|(rd, (_, d))| SegmentEnvelope {
+            run: rd.id.clone(),
+            role: rd.role,
+            env: Ok(d.envelope.clone()),
+        })
+        .collect();
+    // The whole record's envelope pooled over runs with a known rig (SI, each run's own scale).
+    let rigs: Vec<(&pendulum_explain::EnvelopeFit, &pendulum_process::RigParams)> = runs
+        .iter()
+        .zip(&decays)
+        .filter(|(rd, _)| rd.rig.m_kg.is_finite() && rd.rig.l_m.is_finite())
+        .map(|(rd, (_, d))| (&d.envelope, &rd.rig))
+        .collect();
+    let pooled = if rigs.len() == runs.len() {
+        pooled_envelope(&rigs)
+    } else {
+        Vec::new()
+    };
     let f = |name: &str, unit: &str, v: Vec<f64>| Column::f64(name, unit, v);
     let [est, lo, hi, bic, gain]: [Vec<f64>; 5] = nums.try_into().unwrap_or_default();
     pendulum_report::TableOptions::new()
@@ -506,6 +526,44 @@ fn free_decays(
                 Column::new("note", ColumnData::Str(c_note)),
             ],
         )?;
+    let topts = pendulum_report::TableOptions::new()
+        .meta("command", "pendulum discover")
+        .meta("pipeline", pipeline_json.to_string())
+        .meta("base", job.base.name())
+        .meta("analysis", "free decay");
+    write_decay_tables(out, &topts, runs, &decays)?;
+    write_envelopes(&out.join("envelopes.parquet"), &topts, &envs)?;
+    envelope_plot(
+        &out.join("envelopes.png"),
+        &envs,
+        "Free decays: amplitude and loss per cycle",
+    )?;
+    loss_plot(&out.join("signatures.png"), &decays, job.base.name())?;
+    if !pooled.is_empty() {
+        let _ = writeln!(
+            report,
+            "## Pooled over the runs\n\nThe loss per cycle of every run, each with its own bob, pooled as a non-negative sum of the catalogue's exact pendulum loss curves (lowest BIC, every interval excluding zero; a coarse view beside the per-run trajectory fits above):\n"
+        );
+        let mut line = Vec::new();
+        for t in &pooled {
+            let _ = writeln!(
+                report,
+                "- `{}`: {:.4e} {} (95 % interval {:.4e} to {:.4e})",
+                t.name, t.estimate, t.unit, t.ci_low, t.ci_high
+            );
+            line.push(format!("{} {:.3e} {}", t.name, t.estimate, t.unit));
+        }
+        let _ = writeln!(
+            text,
+            "envelopes pooled over the {} runs: {}",
+            runs.len(),
+            line.join(", ")
+        );
+    }
+    let _ = writeln!(
+        report,
+        "\n## Tables and figures\n\n- `diagnosis.parquet`: every candidate per run, with its verdict\n- `params.parquet`: each run's base and best model, parameters with 95 % intervals\n- `runs.parquet`: per run, samples, turning points, held-out E_θ of each model\n- `signatures.parquet`: loss per cycle by amplitude band, measured and as each model predicts it\n- `envelopes.parquet`: every turning point's amplitude and loss per cycle\n\n![signatures.png](signatures.png)\n\n![envelopes.png](envelopes.png)\n"
+    );
     let report_path = out.join("report.md");
     std::fs::write(&report_path, report).map_err(|source| JobError::Io {
         path: report_path.clone(),
@@ -545,10 +603,235 @@ fn free_decays(
             forcing_not_understood: Vec::new(),
         },
         decays,
-        envelopes: Vec::new(),
-        pooled: Vec::new(),
+        envelopes: envs.into_iter().map(|e| (e.run, e.env)).collect(),
+        pooled,
         text,
     })
+}
+
+/// A free decay's base terms and the candidates screened against them, for each `--base`:
+/// the same three models as a shaker campaign's (reference = a, b, μ; linear = b; dry = μ), each
+/// candidate being a catalogue loss the base lacks.
+fn decay_terms(base: Base) -> (Vec<pendulum_explain::Term>, Vec<pendulum_explain::Term>) {
+    use pendulum_explain::Term;
+    let base_terms = match base {
+        Base::Reference => vec![
+            Term::ViscousLinear,
+            Term::ViscousQuadratic,
+            Term::CoulombBearing,
+        ],
+        Base::Linear => vec![Term::ViscousLinear],
+        Base::Dry => vec![Term::CoulombBearing],
+    };
+    // Catalogue order puts the simpler, commoner losses first (the screen prefers earlier ones
+    // within noise of the best).
+    let candidates = [
+        Term::CoulombConstant,
+        Term::ViscousLinear,
+        Term::ViscousQuadratic,
+        Term::CoulombBearing,
+    ]
+    .into_iter()
+    .filter(|t| !base_terms.contains(t))
+    .collect();
+    (base_terms, candidates)
+}
+
+/// params.parquet, runs.parquet and signatures.parquet of a free-decay campaign: each run's base
+/// and best model (parameters and their physical ratios, 95 % intervals), each run's held-out
+/// scores, and the loss per cycle by amplitude band, measured and as each model predicts it.
+fn write_decay_tables(
+    out: &Path,
+    opts: &pendulum_report::TableOptions,
+    runs: &[pendulum_process::RunData],
+    decays: &[(String, pendulum_explain::DecayDiagnosis)],
+) -> Result<(), JobError> {
+    let (mut p_run, mut p_model, mut p_terms, mut p_name, mut p_unit, mut p_kind) = (
+        Vec::new(),
+        Vec::new(),
+        Vec::new(),
+        Vec::new(),
+        Vec::new(),
+        Vec::new(),
+    );
+    let (mut p_est, mut p_lo, mut p_hi) = (Vec::new(), Vec::new(), Vec::new());
+    for (id, d) in decays {
+        for (model, fit) in [("base", &d.base), ("best", &d.best)] {
+            for (kind, list) in [("fitted", &fit.params), ("physical", &fit.physical)] {
+                for e in list {
+                    p_run.push(id.clone());
+                    p_model.push(model.to_string());
+                    p_terms.push(fit.terms.join("+"));
+                    p_kind.push(kind.to_string());
+                    p_name.push(e.name.clone());
+                    p_unit.push(e.unit.clone());
+                    p_est.push(e.estimate);
+                    p_lo.push(e.ci_low);
+                    p_hi.push(e.ci_high);
+                }
+            }
+        }
+    }
+    opts.write(
+        &out.join("params.parquet"),
+        &[
+            Column::new("run_id", ColumnData::Str(p_run)),
+            Column::new("model", ColumnData::Str(p_model)),
+            Column::new("terms", ColumnData::Str(p_terms)),
+            Column::new("kind", ColumnData::Str(p_kind)),
+            Column::new("param", ColumnData::Str(p_name)),
+            Column::f64("estimate", "see column unit", p_est),
+            Column::f64("ci_low", "see column unit", p_lo),
+            Column::f64("ci_high", "see column unit", p_hi),
+            Column::new("unit", ColumnData::Str(p_unit)),
+        ],
+    )?;
+
+    let score = |d: &pendulum_explain::DecayDiagnosis, prefix: &str| {
+        d.heldout
+            .iter()
+            .find(|h| h.model.starts_with(prefix))
+            .map_or(f64::NAN, |h| h.e_theta_rad)
+    };
+    let role = |id: &str| {
+        runs.iter()
+            .find(|r| r.id == id)
+            .map_or(String::new(), |r| r.role.as_str().to_string())
+    };
+    let col = |f: &dyn Fn(&pendulum_explain::DecayDiagnosis) -> f64| -> Vec<f64> {
+        decays.iter().map(|(_, d)| f(d)).collect()
+    };
+    opts.write(
+        &out.join("runs.parquet"),
+        &[
+            Column::new(
+                "run_id",
+                ColumnData::Str(decays.iter().map(|(id, _)| id.clone()).collect()),
+            ),
+            Column::new(
+                "role",
+                ColumnData::Str(decays.iter().map(|(id, _)| role(id)).collect()),
+            ),
+            Column::new(
+                "alignment",
+                ColumnData::Str(decays.iter().map(|_| "free_decay".to_string()).collect()),
+            ),
+            Column::f64("samples", "1", col(&|d| d.samples as f64)),
+            Column::f64("duration_s", "s", col(&|d| d.duration_s)),
+            Column::f64("turning_points", "1", col(&|d| d.turning_points as f64)),
+            Column::f64("t_motion_from_s", "s", col(&|d| d.t_motion_from_s)),
+            Column::f64("t_motion_to_s", "s", col(&|d| d.t_motion_to_s)),
+            Column::f64(
+                "t_split_s",
+                "s (fitted before, scored after)",
+                col(&|d| d.t_split_s),
+            ),
+            Column::f64("noise_rad", "rad", col(&|d| d.envelope.noise_rad)),
+            Column::f64(
+                "e_theta_heldout_base",
+                "rad",
+                col(&|d| score(d, "base")),
+            ),
+            Column::f64(
+                "e_theta_heldout_best",
+                "rad (NaN: nothing added)",
+                col(&|d| score(d, "best")),
+            ),
+            Column::new(
+                "accepted",
+                ColumnData::Str(decays.iter().map(|(_, d)| d.accepted.join("+")).collect()),
+            ),
+        ],
+    )?;
+
+    let (mut s_run, mut from, mut to, mut mean, mut cycles) =
+        (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let (mut meas, mut se, mut base, mut best) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    for (id, d) in decays {
+        for b in &d.loss_bands {
+            s_run.push(id.clone());
+            from.push(b.amplitude_from_rad);
+            to.push(b.amplitude_to_rad);
+            mean.push(b.amplitude_mean_rad);
+            cycles.push(b.cycles as f64);
+            meas.push(b.measured_rad);
+            se.push(b.measured_se_rad);
+            base.push(b.base_model_rad);
+            best.push(b.best_model_rad);
+        }
+    }
+    opts.write(
+        &out.join("signatures.parquet"),
+        &[
+            Column::new("run_id", ColumnData::Str(s_run)),
+            Column::f64("amplitude_from", "rad", from),
+            Column::f64("amplitude_to", "rad", to),
+            Column::f64("amplitude_mean", "rad", mean),
+            Column::f64("cycles", "1", cycles),
+            Column::f64("loss_per_cycle_measured", "rad", meas),
+            Column::f64("loss_per_cycle_measured_se", "rad", se),
+            Column::f64("loss_per_cycle_base", "rad (full-record fit)", base),
+            Column::f64("loss_per_cycle_best", "rad (full-record fit)", best),
+        ],
+    )?;
+    Ok(())
+}
+
+/// What a free decay's models get wrong, against amplitude: each run's measured loss per cycle
+/// (points, by amplitude band) beside the base model's (line) and the
+/// best model's prediction, in one panel per run (at most six).
+fn loss_plot(
+    path: &Path,
+    decays: &[(String, pendulum_explain::DecayDiagnosis)],
+    base: &str,
+) -> Result<(), JobError> {
+    let panels: Vec<Panel> = decays
+        .iter()
+        .take(6)
+        .map(|(id, d)| {
+            let pick = |f: &dyn Fn(&pendulum_explain::LossBand) -> f64| -> Vec<f64> {
+                d.loss_bands.iter().map(f).collect()
+            };
+            let x = pick(&|b| b.amplitude_mean_rad);
+            Panel {
+                title: format!("run {id}: best = {}", d.best.terms.join(" + ")),
+                x_label: "amplitude (rad)".into(),
+                y_label: "loss per cycle (rad)".into(),
+                series: vec![
+                    Series {
+                        label: "measured".into(),
+                        x: x.clone(),
+                        y: pick(&|b| b.measured_rad),
+                        style: SeriesStyle::Points,
+                        color: Some(0),
+                    },
+                    Series {
+                        label: format!("base ({base})"),
+                        x: x.clone(),
+                        y: pick(&|b| b.base_model_rad),
+                        style: SeriesStyle::Line,
+                        color: Some(1),
+                    },
+                    Series {
+                        label: "best".into(),
+                        x,
+                        y: pick(&|b| b.best_model_rad),
+                        style: SeriesStyle::LinePoints,
+                        color: Some(2),
+                    },
+                ],
+                ..Panel::default()
+            }
+        })
+        .collect();
+    let fig = Figure {
+        title: "Free decays: loss per cycle against amplitude, measured and modelled".into(),
+        height: 400 * panels.len().max(1) as u32,
+        panels,
+        width: 1200,
+    };
+    fig.save_png(path)?;
+    Ok(())
 }
 
 fn e(v: &[pendulum_process::identify::RunFit]) -> f64 {
@@ -662,6 +945,11 @@ pub fn pooled_envelope(
                     .collect()
             })
             .collect();
+        // A term whose SI factor is unknown for some run (r_b not given: the bearing load) is
+        // not pooled.
+        if x.iter().flatten().any(|v| !v.is_finite()) {
+            continue;
+        }
         let Some((b, cov, rms)) = pendulum_process::linalg::lstsq(&x, &y) else {
             continue;
         };
@@ -731,7 +1019,7 @@ fn write_envelopes(
 }
 
 /// Amplitude against time and loss per cycle against amplitude, one colour per run.
-fn envelope_plot(path: &Path, envs: &[SegmentEnvelope]) -> Result<(), JobError> {
+fn envelope_plot(path: &Path, envs: &[SegmentEnvelope], title: &str) -> Result<(), JobError> {
     let ok: Vec<(&str, &pendulum_explain::EnvelopeFit)> = envs
         .iter()
         .filter_map(|e| e.env.as_ref().ok().map(|f| (e.run.as_str(), f)))
@@ -757,7 +1045,7 @@ fn envelope_plot(path: &Path, envs: &[SegmentEnvelope]) -> Result<(), JobError> 
             .collect::<Vec<_>>()
     };
     let fig = Figure {
-        title: "Free-decay segments before the shaker starts".into(),
+        title: title.into(),
         panels: vec![
             Panel {
                 title: "amplitude at each turning point".into(),
