@@ -30,6 +30,12 @@ fn discover(seed: u64, base: Base, a: f64, b: f64, mu: f64, effects: &str) -> Di
     })
     .unwrap();
     eprintln!("{s}");
+    if let Ok(keep) = std::env::var("SURVEY_KEEP") {
+        let to = Path::new(&keep);
+        std::fs::create_dir_all(to).unwrap();
+        std::fs::write(to.join("case.toml"), campaign(seed, a, b, mu, effects)).unwrap();
+        eprintln!("kept the twin case in {}", to.display());
+    }
     for f in [
         "diagnosis.parquet",
         "signatures.parquet",
@@ -474,8 +480,16 @@ fn survey_issue_5_every_effect() {
     b.sort_unstable();
     assert_eq!(a, b);
     let (mut hits, mut total, mut within) = (0, 0, 0);
+    // `SURVEY_ONE=effect:k` re-runs one campaign of the survey (`SURVEY_KEEP=DIR` keeps it).
+    let one = std::env::var("SURVEY_ONE").ok();
     for (e_idx, effect) in effects.iter().enumerate() {
-        for k in 0..n {
+        for k in 0..n.max(5) {
+            if one
+                .as_deref()
+                .map_or(k >= n, |o| o != format!("{effect}:{k}"))
+            {
+                continue;
+            }
             let mut r = rng(1000 + 100 * e_idx as u64 + k);
             let (truth, spec, base, a, b, mu) = draw(effect, &mut r);
             let s = discover(5000 + 100 * e_idx as u64 + k, base, a, b, mu, &spec);
@@ -508,6 +522,9 @@ fn survey_issue_5_every_effect() {
     ];
     let mut pair_hits = 0;
     for (p_idx, (e1, e2)) in pairs.iter().enumerate() {
+        if one.is_some() {
+            break;
+        }
         let mut r = rng(3000 + p_idx as u64);
         let (t1, s1, _, _, _, _) = draw(e1, &mut r);
         let (t2, s2, _, _, _, _) = draw(e2, &mut r);
@@ -600,9 +617,7 @@ fn free_decay_campaign(dir: &Path, seed: u64, b: f64, mu: f64) -> Vec<f64> {
         betas.push(phys.to_dimensionless().beta);
         eprintln!(
             "free decay d{k}: m {} kg, l {:.4} m, θ0 {theta0:.3} rad, {duration_s:.1} s, β {:.4e}",
-            phys.m_kg,
-            phys.l_m,
-            betas[k]
+            phys.m_kg, phys.l_m, betas[k]
         );
     }
     std::fs::write(dir.join("campaign.toml"), toml).unwrap();
