@@ -694,3 +694,54 @@ fn regression_issue_12_free_decays_honour_base() {
         );
     }
 }
+
+/// Issue 12 item 2: a run whose forcing the crank-rod model cannot explain is flagged, and no
+/// effect is named from it. The twin records every run with a 575 mm rod; the campaign then
+/// claims a 250 mm rod for run r01 (a wrong `rod_L_m`, as a user's typo would), so its crank fit
+/// has the wrong second harmonic (λ = r/L off by a factor 2.3) and leaves far more than the
+/// sensor's noise on the accelerometer. Nothing is hidden, so nothing may be named.
+#[test]
+fn regression_issue_12_forcing_not_understood_is_flagged() {
+    let dir = tempfile::tempdir().unwrap();
+    let camp = dir.path().join("campaign");
+    make_campaign(&camp, &campaign(1207, 0.0, 0.5, 0.15, ""));
+    let toml_path = camp.join("campaign.toml");
+    let text = std::fs::read_to_string(&toml_path).unwrap();
+    let text = text.replacen("id = \"r01\"\n", "id = \"r01\"\nrod_L_m = 0.25\n", 1);
+    assert!(text.contains("rod_L_m = 0.25"));
+    std::fs::write(&toml_path, text).unwrap();
+    let s = run(&DiscoverJob {
+        input: camp,
+        out: dir.path().join("out"),
+        base: Base::Reference,
+        pipeline: None,
+        generations: Some(300),
+        seed: None,
+        progress: false,
+    })
+    .unwrap();
+    eprintln!("{s}");
+    let flagged: Vec<&str> = s
+        .discovery
+        .forcing_not_understood
+        .iter()
+        .map(|(id, _, _)| id.as_str())
+        .collect();
+    assert_eq!(flagged, ["r01"], "runs flagged: {flagged:?}");
+    let runs = s.out_dir.join("runs.parquet");
+    let ids = crate::identify::column_str(&runs, "run_id");
+    let understood = crate::identify::column_bool(&runs, "forcing_understood");
+    for (id, ok) in ids.iter().zip(&understood) {
+        assert_eq!(*ok, id != "r01", "run {id}: forcing_understood = {ok}");
+    }
+    let report = std::fs::read_to_string(s.out_dir.join("report.md")).unwrap();
+    assert!(
+        report.contains("Forcing not understood") && report.contains("`r01`"),
+        "{report}"
+    );
+    assert!(
+        s.discovery.accepted().is_empty(),
+        "named {:?} with nothing hidden",
+        s.discovery.accepted()
+    );
+}

@@ -78,6 +78,17 @@ pub(crate) fn column_f64(path: &Path, name: &str) -> Vec<f64> {
         .collect()
 }
 
+pub(crate) fn column_bool(path: &Path, name: &str) -> Vec<bool> {
+    use arrow_array::{Array, BooleanArray};
+    column_arrays(path, name)
+        .iter()
+        .flat_map(|c| {
+            let a = c.as_any().downcast_ref::<BooleanArray>().unwrap();
+            (0..a.len()).map(|i| a.value(i)).collect::<Vec<_>>()
+        })
+        .collect()
+}
+
 pub(crate) fn column_str(path: &Path, name: &str) -> Vec<String> {
     use arrow_array::{Array, StringArray};
     column_arrays(path, name)
