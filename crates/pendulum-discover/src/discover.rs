@@ -895,7 +895,7 @@ impl Problem for ParamsOnly<'_> {
     }
 }
 
-/// The objective every confirming refit and its evaluation use (κ = 2, tolerance 1e-6).
+/// The objective every confirming refit and its evaluation use (output error, tolerance 1e-6).
 fn refit_objective<'a>(runs: &'a [PreparedRun], spec: &'a ModelSpec) -> StudyObjective<'a> {
     StudyObjective {
         runs,
@@ -904,7 +904,13 @@ fn refit_objective<'a>(runs: &'a [PreparedRun], spec: &'a ModelSpec) -> StudyObj
         sim: pendulum_model::SimOptions::with_tol(1e-6),
         ic_halfwidth: 0.1,
         fixed_params: None,
-        penalty: true,
+        // Output error only. The study's steady-state penalty (κ × E_θ when the simulated tail's
+        // class differs from the measured one) chooses among models in the identify fit; in a
+        // refit that checks one parameter's value it is a discontinuous term that pulls the value
+        // towards whatever reproduces the tails' classes (a hidden 0.0102 N·m dry torque was
+        // refitted at 0.0173 on a drawn design with three chaotic identify runs; without the
+        // penalty the two views agreed and it was named).
+        penalty: false,
         order: Default::default(),
     }
 }
