@@ -600,9 +600,7 @@ fn free_decay_campaign(dir: &Path, seed: u64, b: f64, mu: f64) -> Vec<f64> {
         betas.push(phys.to_dimensionless().beta);
         eprintln!(
             "free decay d{k}: m {} kg, l {:.4} m, θ0 {theta0:.3} rad, {duration_s:.1} s, β {:.4e}",
-            phys.m_kg,
-            phys.l_m,
-            betas[k]
+            phys.m_kg, phys.l_m, betas[k]
         );
     }
     std::fs::write(dir.join("campaign.toml"), toml).unwrap();
