@@ -619,7 +619,7 @@ fn regression_issue_13_a_short_stale_block_does_not_discard_the_rest() {
         assert!(
             st.skips[0]
                 .reason
-                .contains("+600.000000 s off the timeline")
+                .contains("+600.005000 s off the timeline")
                 && st.skips[0].reason.contains("resumes at"),
             "{what}: {:?}",
             st.skips[0]
@@ -649,13 +649,33 @@ fn regression_issue_13_duplicated_serial_chunks_lose_no_good_data() {
     assert_eq!(st.duplicates, 200, "both copies recognised as copies");
     assert_eq!(st.gap_count, 0, "{:?}", st.gaps);
     assert_eq!(st.new_segments, 0);
-    // The first copy's lines are 501.. (header 5 lines + column line).
+    // The early copy starts at line 506 (4 header lines and the column line): off the timeline
+    // that resumes right after it (its original, 1,900 lines on, makes it a duplicate later).
     assert!(
-        st.skips[0].at == Location::Line(507) && st.skips[0].reason.contains("duplicated chunk"),
+        st.skips[0].at == Location::Line(506)
+            && st.skips[0]
+                .reason
+                .contains("+9.505000 s off the timeline, which resumes at line 606"),
         "{:?}",
         st.skips[0]
     );
     assert_time_increases(&samples, "serial");
+
+    // A chunk repeated right after itself: named a copy of the line it repeats.
+    let mut rows = good[..1000].to_vec();
+    rows.extend_from_slice(&good[900..1000]);
+    rows.extend_from_slice(&good[1000..]);
+    let (samples, st) = read_capture(&serial_bytes(&rows, &Header::serial_v1()), false);
+    assert_eq!(encoder_rows(&samples), want);
+    assert_eq!((st.off_timeline, st.duplicates), (100, 100));
+    assert!(
+        st.skips[0].at == Location::Line(1006)
+            && st.skips[0]
+                .reason
+                .contains("repeats the record kept at line 906 (a duplicated chunk"),
+        "{:?}",
+        st.skips[0]
+    );
 }
 
 /// A board reset mid-capture: the clock restarts near zero (and the count at the power-on

@@ -658,39 +658,65 @@ pub(crate) trait Record {
     fn fingerprint(&self) -> u64;
 }
 
-/// The last records kept, to recognise a duplicated chunk that comes back after its original.
-#[derive(Debug)]
-pub(crate) struct Recent {
-    buf: std::collections::VecDeque<(u32, u64, Location)>,
+/// How many kept (and dropped) records [`Recent`] remembers: 40 s of serial lines, 8 s of SD
+/// frames, ~0.5 MB.
+const RECENT_RECORDS: usize = 8192;
+
+/// Records by stamp and values, forgetting the oldest beyond [`RECENT_RECORDS`].
+#[derive(Debug, Default)]
+struct Remembered {
+    map: std::collections::HashMap<(u32, u64), Location>,
+    order: std::collections::VecDeque<(u32, u64)>,
 }
 
-impl Default for Recent {
-    fn default() -> Self {
-        Self {
-            buf: std::collections::VecDeque::with_capacity(TIMELINE_WINDOW),
+impl Remembered {
+    fn insert(&mut self, key: (u32, u64), at: Location) {
+        if self.order.len() == RECENT_RECORDS {
+            if let Some(old) = self.order.pop_front() {
+                self.map.remove(&old);
+            }
+        }
+        if self.map.insert(key, at).is_none() {
+            self.order.push_back(key);
         }
     }
+
+    fn clear(&mut self) {
+        self.map.clear();
+        self.order.clear();
+    }
+}
+
+/// The last records kept, to recognise a duplicated chunk that comes back after its original,
+/// and the last ones dropped off the timeline, to recognise a copy that came before its
+/// original once the original arrives.
+#[derive(Debug, Default)]
+pub(crate) struct Recent {
+    kept: Remembered,
+    dropped: Remembered,
 }
 
 impl Recent {
-    pub(crate) fn push(&mut self, r: &impl Record) {
-        if self.buf.len() == TIMELINE_WINDOW {
-            self.buf.pop_front();
-        }
-        self.buf.push_back((r.t_raw(), r.fingerprint(), r.at()));
+    /// Remembers a kept record; true if it is the original of a copy dropped earlier (then
+    /// that copy is a duplicate).
+    pub(crate) fn push_kept(&mut self, r: &impl Record) -> bool {
+        let key = (r.t_raw(), r.fingerprint());
+        self.kept.insert(key, r.at());
+        self.dropped.map.remove(&key).is_some()
+    }
+
+    /// Remembers a record dropped off the timeline that was not recognised as a copy.
+    pub(crate) fn push_dropped(&mut self, r: &impl Record) {
+        self.dropped.insert((r.t_raw(), r.fingerprint()), r.at());
     }
 
     fn find(&self, r: &impl Record) -> Option<Location> {
-        let (t, f) = (r.t_raw(), r.fingerprint());
-        self.buf
-            .iter()
-            .rev()
-            .find(|(t0, f0, _)| *t0 == t && *f0 == f)
-            .map(|x| x.2)
+        self.kept.map.get(&(r.t_raw(), r.fingerprint())).copied()
     }
 
     pub(crate) fn clear(&mut self) {
-        self.buf.clear();
+        self.kept.clear();
+        self.dropped.clear();
     }
 }
 

@@ -581,6 +581,9 @@ impl<R: Read> SdReader<R> {
                     let reason = if off_timeline {
                         self.stats.off_timeline += 1;
                         self.stats.duplicates += u64::from(duplicate);
+                        if !duplicate {
+                            self.recent.push_dropped(&cand);
+                        }
                         format!("frame with valid CRC dropped: {reason}")
                     } else {
                         format!(
@@ -637,7 +640,10 @@ impl<R: Read> SdReader<R> {
                 None => self.clock.commit(cand.t_us, t_us, &mut self.stats),
             }
             self.stats.kept_bytes += cand.len;
-            self.recent.push(&cand);
+            if self.recent.push_kept(&cand) {
+                // A copy seen before its original (dropped off the timeline) was a duplicate.
+                self.stats.duplicates += 1;
+            }
             if cand.kind == FRAME_ENCODER {
                 let count_raw = cand.i16_at(0);
                 self.enc_gaps.step(t_us, &mut self.stats);

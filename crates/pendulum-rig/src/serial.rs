@@ -357,6 +357,9 @@ impl<R: BufRead> SerialReader<R> {
                     let reason = if off_timeline {
                         self.stats.off_timeline += 1;
                         self.stats.duplicates += u64::from(duplicate);
+                        if !duplicate {
+                            self.recent.push_dropped(&cand);
+                        }
                         format!("{reason}: dropped")
                     } else {
                         format!("{reason} (t_us={}): garbled", cand.t_us)
@@ -396,7 +399,10 @@ impl<R: BufRead> SerialReader<R> {
             self.stats.kept_encoder(t_us);
             self.stats.accel_samples += 1;
             self.stats.kept_bytes += cand.bytes;
-            self.recent.push(&cand);
+            if self.recent.push_kept(&cand) {
+                // A copy seen before its original (dropped off the timeline) was a duplicate.
+                self.stats.duplicates += 1;
+            }
             self.last_row = Some((cand.t_us, cand.enc, cand.accel));
             self.pending_accel = Some(AccelSample {
                 t_us_raw: cand.t_us,
