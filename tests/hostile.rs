@@ -733,7 +733,7 @@ fn regression_issue_13_a_board_reset_starts_a_new_segment() {
 
 /// Script 03: a garbled digit that stays a digit (an 8,000-count encoder jump in 5 ms) was kept
 /// and multiplied a run's E_θ by 100. Both readers drop values that move faster than the
-/// pendulum (10 rev/s) or the shaker (2,000 m/s³) can, and report them; fast but physical
+/// pendulum (25 rev/s) or the shaker (2,000 m/s³) can, and report them; fast but physical
 /// motion is kept.
 #[test]
 fn regression_issue_13_values_physics_forbids_are_dropped_by_both_readers() {
@@ -775,10 +775,11 @@ fn regression_issue_13_values_physics_forbids_are_dropped_by_both_readers() {
         assert_eq!(kept.len(), want_enc, "{what}");
     }
 
-    // Fast but physical: 7 rev/s (143 counts per 5 ms) is kept whole, in both readers.
+    // Fast but physical: a hand spin of 19.5 rev/s (400 counts per 5 ms) is kept whole, in
+    // both readers.
     let spin: Vec<Row> = (0..1000)
         .map(|k| {
-            let c = (143 * k as i64).rem_euclid(65536) as u16 as i16;
+            let c = (400 * k as i64).rem_euclid(65536) as u16 as i16;
             (1_000_000 + 5000 * k as u32, c, [0, 0, 8192])
         })
         .collect();

@@ -502,13 +502,14 @@ pub(crate) const TIMELINE_WINDOW: usize = 512;
 pub const RESET_NEAR_ZERO_US: u32 = 10_000_000;
 
 /// The fastest the pendulum can turn, in revolutions per second, for the plausibility of an
-/// encoder step. From rig.md's rig: a rotation at the crank's top speed (2πΩ = 14.8 rad/s at
-/// Ω = 2.36 Hz) plus the speed gained falling over the top against the largest base
-/// acceleration (r ω² (1 + λ) = 61 m/s² at r = 0.205 m, L = 0.575 m) on the shortest arm
-/// (l = 0.17 m): sqrt(ω² + 4 (g + ÿ_max) / l) = 43 rad/s = 6.9 rev/s. 10 rev/s (62.8 rad/s,
-/// 41 counts per ms) leaves ×1.45 for a hand spin and what the bound leaves out. A garbled digit
-/// (8,000 counts in 5 ms: 390 rev/s) is far outside.
-pub const MAX_ENCODER_REV_PER_S: f64 = 10.0;
+/// encoder step. From rig.md's rig, the shaker can drive at most a rotation at the crank's top
+/// speed (2πΩ = 14.8 rad/s at Ω = 2.36 Hz) plus the speed gained falling over the top against
+/// the largest base acceleration (r ω² (1 + λ) = 61 m/s² at r = 0.205 m, L = 0.575 m) on the
+/// shortest arm (l = 0.17 m): sqrt(ω² + 4 (g + ÿ_max) / l) = 43 rad/s = 6.9 rev/s. The operator
+/// may spin it faster by hand before the shaker starts: the twin's hand spin that wraps the
+/// 16-bit count is 75 rad/s (11.9 rev/s). 25 rev/s (157 rad/s, 102 counts per ms, 512 per 5 ms)
+/// is twice that; a garbled digit (8,000 counts in 5 ms: 390 rev/s) is far outside.
+pub const MAX_ENCODER_REV_PER_S: f64 = 25.0;
 
 /// Counts always allowed between two encoder samples on top of the speed bound: the
 /// quantisation (±1) and a little stamp jitter.
