@@ -388,8 +388,8 @@ impl IngestStats {
             ));
         }
         if let (Some(a), Some(b)) = (self.encoder_first_t_us, self.encoder_last_t_us) {
-            if self.encoder_period_us > 0 {
-                let implied = (b.saturating_sub(a) / self.encoder_period_us) + 1;
+            if let Some(steps) = b.saturating_sub(a).checked_div(self.encoder_period_us) {
+                let implied = steps + 1;
                 if (self.encoder_samples as f64) < MIN_KEPT_FRACTION * implied as f64 {
                     return Some(format!(
                         "kept {} encoder samples over {:.3} s, where a sample every {} µs implies {implied}: the stream is mostly holes",
