@@ -3,10 +3,15 @@
 //! reproduction scripts (`shared/repro/reliability/`) and fails on the code before its fix.
 
 use std::collections::BTreeMap;
+use std::f64::consts::TAU;
 use std::path::{Path, PathBuf};
 use std::process::Output;
 
 use pendulum_log::{EncoderMsg, RunLogOptions, METADATA_RUN};
+use pendulum_rig::{
+    Campaign, Header, IngestStats, Location, ReadOptions, Sample, SdReader, SdWriter, SerialReader,
+    SerialWriter,
+};
 
 use crate::ingest::{tiny_capture, GOOD_RIG};
 use crate::util::pendulum;
@@ -487,5 +492,467 @@ fn issue_13_messages_name_the_cause() {
     assert!(
         stdout.contains("note: --np 2 raised to 4"),
         "{stdout}{stderr}"
+    );
+}
+
+// ---- Issue 13, items 2–5: the timeline follows the majority of the evidence, values obey
+// physics, a run that keeps almost nothing fails, a misspelt campaign key is named. ----
+
+/// One line / frame pair of a capture: raw time, raw encoder count, raw accelerometer.
+type Row = (u32, i16, [i16; 3]);
+
+/// `n` records every 5 ms from `t0_us`: a swing of ±500 counts at 1.5 Hz (1.2 rev/s at its
+/// fastest) and the table's acceleration at 1.54 Hz.
+fn swing(n: usize, t0_us: u32) -> Vec<Row> {
+    (0..n)
+        .map(|k| {
+            let t = k as f64 * 0.005;
+            let enc = (500.0 * (TAU * 1.5 * t).sin()).round() as i16;
+            let az = 8192 + (2000.0 * (TAU * 1.54 * t).cos()).round() as i16;
+            (t0_us.wrapping_add(5000 * k as u32), enc, [12, -7, az])
+        })
+        .collect()
+}
+
+fn serial_bytes(rows: &[Row], header: &Header) -> Vec<u8> {
+    let mut w = SerialWriter::new(Vec::new(), header).unwrap();
+    for &(t, e, a) in rows {
+        w.write_sample(t, e, a).unwrap();
+    }
+    w.finish().unwrap()
+}
+
+/// The SD twin of [`serial_bytes`]: an encoder and an accelerometer frame per row (both
+/// streams at 200 Hz, as the header says).
+fn sd_bytes(rows: &[Row], header: &Header) -> Vec<u8> {
+    let mut w = SdWriter::new(Vec::new(), header).unwrap();
+    for &(t, e, a) in rows {
+        w.write_encoder(t, e).unwrap();
+        w.write_accel(t, a).unwrap();
+    }
+    w.finish().unwrap()
+}
+
+fn sd_header_200() -> Header {
+    Header::sd_v2()
+        .with("encoder_hz", "200")
+        .with("accel_hz", "200")
+}
+
+/// Every sample and the stats of a serial (`sd = false`) or SD capture.
+fn read_capture(bytes: &[u8], sd: bool) -> (Vec<Sample>, IngestStats) {
+    let mut out = Vec::new();
+    if sd {
+        let mut r = SdReader::new(bytes, "t.bin", ReadOptions::default()).unwrap();
+        while let Some(s) = r.next_sample().unwrap() {
+            out.push(s);
+        }
+        (out, r.stats().clone())
+    } else {
+        let mut r = SerialReader::new(bytes, "t.csv", ReadOptions::default()).unwrap();
+        while let Some(s) = r.next_sample().unwrap() {
+            out.push(s);
+        }
+        (out, r.stats().clone())
+    }
+}
+
+/// The kept encoder samples as `(raw t, raw count)`.
+fn encoder_rows(samples: &[Sample]) -> Vec<(u32, i16)> {
+    samples
+        .iter()
+        .filter_map(|s| match s {
+            Sample::Encoder(e) => Some((e.t_us_raw, e.count_raw)),
+            _ => None,
+        })
+        .collect()
+}
+
+fn assert_time_increases(samples: &[Sample], what: &str) {
+    let enc: Vec<u64> = samples
+        .iter()
+        .filter_map(|s| match s {
+            Sample::Encoder(e) => Some(e.t_us),
+            _ => None,
+        })
+        .collect();
+    assert!(
+        enc.windows(2).all(|w| w[0] < w[1]),
+        "{what}: encoder time must increase"
+    );
+}
+
+/// Script 02: 40 valid frames stamped 10 minutes ahead in the middle of an SD capture (under
+/// one bad SD sector) used to be believed and make the reader drop the REST of the run
+/// (6,000 of 12,000 frames) as "time goes backwards". The 40 are dropped and reported, every
+/// good frame is kept, and no 10-minute gap appears. The same for a serial capture.
+#[test]
+fn regression_issue_13_a_short_stale_block_does_not_discard_the_rest() {
+    let good = swing(3000, 1_000_000);
+    for sd in [false, true] {
+        let mut rows = good[..1500].to_vec();
+        rows.extend(
+            good[1500..1540]
+                .iter()
+                .map(|&(t, e, a)| (t.wrapping_add(600_000_000), e, a)),
+        );
+        rows.extend_from_slice(&good[1500..]);
+        let bytes = if sd {
+            sd_bytes(&rows, &sd_header_200())
+        } else {
+            serial_bytes(&rows, &Header::serial_v1())
+        };
+        let (samples, st) = read_capture(&bytes, sd);
+        let what = if sd { "sd" } else { "serial" };
+        let want: Vec<(u32, i16)> = good.iter().map(|r| (r.0, r.1)).collect();
+        assert_eq!(
+            encoder_rows(&samples),
+            want,
+            "{what}: every good record kept"
+        );
+        assert_eq!(st.accel_samples, 3000, "{what}");
+        assert_eq!(st.gap_count, 0, "{what}: no 10-minute gap: {:?}", st.gaps);
+        // One record per stream per row in the SD capture.
+        let per_row = if sd { 2 } else { 1 };
+        assert_eq!(st.off_timeline, 40 * per_row, "{what}: {:?}", st.skips);
+        assert_eq!(st.skipped_lines_or_frames, 40 * per_row, "{what}");
+        assert!(
+            st.skips[0]
+                .reason
+                .contains("+600.005000 s off the timeline")
+                && st.skips[0].reason.contains("resumes at"),
+            "{what}: {:?}",
+            st.skips[0]
+        );
+        assert_time_increases(&samples, what);
+    }
+}
+
+/// Duplicated serial chunks (a terminal program repeating its buffer): a copy of a LATER chunk
+/// inserted early used to be believed as a jump ahead and make everything up to its original
+/// "go backwards" (up to 80 % of a run lost); a copy of an earlier chunk repeated later was
+/// dropped without saying it was a copy. Both copies are recognised (same stamps and values),
+/// dropped and counted; every original line is kept.
+#[test]
+fn regression_issue_13_duplicated_serial_chunks_lose_no_good_data() {
+    let good = swing(3000, 1_000_000);
+    let mut rows = good[..500].to_vec();
+    rows.extend_from_slice(&good[2400..2500]); // a later chunk, early
+    rows.extend_from_slice(&good[500..1000]);
+    rows.extend_from_slice(&good[100..200]); // an earlier chunk, again
+    rows.extend_from_slice(&good[1000..]);
+    let (samples, st) = read_capture(&serial_bytes(&rows, &Header::serial_v1()), false);
+    let want: Vec<(u32, i16)> = good.iter().map(|r| (r.0, r.1)).collect();
+    assert_eq!(encoder_rows(&samples), want, "every original line kept");
+    assert_eq!(st.skipped_lines_or_frames, 200);
+    assert_eq!(st.off_timeline, 200);
+    assert_eq!(st.duplicates, 200, "both copies recognised as copies");
+    assert_eq!(st.gap_count, 0, "{:?}", st.gaps);
+    assert_eq!(st.new_segments, 0);
+    // The early copy starts at line 506 (4 header lines and the column line): off the timeline
+    // that resumes right after it (its original, 1,900 lines on, makes it a duplicate later).
+    assert!(
+        st.skips[0].at == Location::Line(506)
+            && st.skips[0]
+                .reason
+                .contains("+9.505000 s off the timeline, which resumes at line 606"),
+        "{:?}",
+        st.skips[0]
+    );
+    assert_time_increases(&samples, "serial");
+
+    // A chunk repeated right after itself: named a copy of the line it repeats.
+    let mut rows = good[..1000].to_vec();
+    rows.extend_from_slice(&good[900..1000]);
+    rows.extend_from_slice(&good[1000..]);
+    let (samples, st) = read_capture(&serial_bytes(&rows, &Header::serial_v1()), false);
+    assert_eq!(encoder_rows(&samples), want);
+    assert_eq!((st.off_timeline, st.duplicates), (100, 100));
+    assert!(
+        st.skips[0].at == Location::Line(1006)
+            && st.skips[0]
+                .reason
+                .contains("repeats the record kept at line 906 (a duplicated chunk"),
+        "{:?}",
+        st.skips[0]
+    );
+}
+
+/// A board reset mid-capture: the clock restarts near zero (and the count at the power-on
+/// zero). Everything after it used to be dropped as "time goes backwards". Both readers keep
+/// it as a new segment placed after the old one, and say so.
+#[test]
+fn regression_issue_13_a_board_reset_starts_a_new_segment() {
+    // Before the reset the clock is well past 2^31 µs, so that the restart also looks like a
+    // forward wrap: 21 minutes ahead, not a wrap.
+    let before = swing(1000, 3_000_000_000);
+    let after = swing(1000, 400_000);
+    for sd in [false, true] {
+        let rows: Vec<Row> = before.iter().chain(&after).copied().collect();
+        let bytes = if sd {
+            sd_bytes(&rows, &sd_header_200())
+        } else {
+            serial_bytes(&rows, &Header::serial_v1())
+        };
+        let (samples, st) = read_capture(&bytes, sd);
+        let what = if sd { "sd" } else { "serial" };
+        let want: Vec<(u32, i16)> = rows.iter().map(|r| (r.0, r.1)).collect();
+        assert_eq!(encoder_rows(&samples), want, "{what}: both segments kept");
+        assert_eq!(st.new_segments, 1, "{what}");
+        assert_eq!(st.skipped_lines_or_frames, 0, "{what}: {:?}", st.skips);
+        assert_eq!(st.clock_wraps, 0, "{what}: a reset is no wrap");
+        assert!(
+            st.warnings.iter().any(|w| w.contains("board reset")),
+            "{what}: {:?}",
+            st.warnings
+        );
+        assert_time_increases(&samples, what);
+        // The new segment starts 0.4 s (the time since the reset) after the old one's end.
+        let enc: Vec<u64> = samples
+            .iter()
+            .filter_map(|s| match s {
+                Sample::Encoder(e) => Some(e.t_us),
+                _ => None,
+            })
+            .collect();
+        assert_eq!(enc[1000] - enc[999], 400_000, "{what}");
+    }
+
+    // A jump back to a timeline that does not come back, not near zero: also a new segment.
+    let later = swing(1000, 2_000_000_000);
+    let rows: Vec<Row> = before.iter().chain(&later).copied().collect();
+    let (samples, st) = read_capture(&serial_bytes(&rows, &Header::serial_v1()), false);
+    assert_eq!(samples.len(), 4000);
+    assert_eq!(st.new_segments, 1);
+    assert!(
+        st.warnings[0].contains("moved back for good"),
+        "{:?}",
+        st.warnings
+    );
+}
+
+/// Script 03: a garbled digit that stays a digit (an 8,000-count encoder jump in 5 ms) was kept
+/// and multiplied a run's E_θ by 100. Both readers drop values that move faster than the
+/// pendulum (25 rev/s) or the shaker (2,000 m/s³) can, and report them; fast but physical
+/// motion is kept.
+#[test]
+fn regression_issue_13_values_physics_forbids_are_dropped_by_both_readers() {
+    let good = swing(2000, 1_000_000);
+    let mut rows = good.clone();
+    for k in [300, 500, 700] {
+        rows[k].1 = rows[k].1.wrapping_add(8000);
+    }
+    rows[900].2[0] = rows[900].2[0].wrapping_add(20_000); // 2.4 g in 5 ms on x
+    for sd in [false, true] {
+        let bytes = if sd {
+            sd_bytes(&rows, &sd_header_200())
+        } else {
+            serial_bytes(&rows, &Header::serial_v1())
+        };
+        let (samples, st) = read_capture(&bytes, sd);
+        let what = if sd { "sd" } else { "serial" };
+        assert_eq!(st.implausible, 4, "{what}: {:?}", st.skips);
+        assert_eq!(st.skipped_lines_or_frames, 4, "{what}");
+        assert!(
+            st.skips[0].reason.contains(" counts in 5000 µs")
+                && st.skips[0].reason.contains("faster than the pendulum"),
+            "{what}: {:?}",
+            st.skips[0]
+        );
+        assert!(
+            st.skips[3].reason.contains("faster than the shaker"),
+            "{what}: {:?}",
+            st.skips[3]
+        );
+        let kept = encoder_rows(&samples);
+        let spikes = kept.iter().filter(|(t, e)| {
+            let k = ((t - 1_000_000) / 5000) as usize;
+            *e != good[k].1
+        });
+        assert_eq!(spikes.count(), 0, "{what}: no spike kept");
+        // Serial drops the whole line; SD only the frame that is wrong.
+        let want_enc = if sd { 1997 } else { 1996 };
+        assert_eq!(kept.len(), want_enc, "{what}");
+    }
+
+    // Fast but physical: a hand spin of 19.5 rev/s (400 counts per 5 ms) is kept whole, in
+    // both readers.
+    let spin: Vec<Row> = (0..1000)
+        .map(|k| {
+            let c = (400 * k as i64).rem_euclid(65536) as u16 as i16;
+            (1_000_000 + 5000 * k as u32, c, [0, 0, 8192])
+        })
+        .collect();
+    for sd in [false, true] {
+        let bytes = if sd {
+            sd_bytes(&spin, &sd_header_200())
+        } else {
+            serial_bytes(&spin, &Header::serial_v1())
+        };
+        let (samples, st) = read_capture(&bytes, sd);
+        assert_eq!(encoder_rows(&samples).len(), 1000, "{:?}", st.skips);
+        assert_eq!(st.implausible, 0);
+    }
+}
+
+/// Script 04: a header rate 5× the real one made the serial reader drop every line but one as
+/// "time jumps ahead" and ingest exit 0 with a near-empty MCAP. The header rate is checked
+/// against the median step (both readers, one rule): the stamps win, with a warning. A run that
+/// still keeps almost nothing (a trailing blank on every line, a garbage body, a stream that is
+/// mostly holes) fails: ingest names it, writes no MCAP for it and exits 1.
+#[test]
+fn regression_issue_13_rate_mismatch_is_named_and_near_empty_runs_fail() {
+    let good = swing(400, 1_000_000);
+    // The readers: the measured rate wins, both say so.
+    let (samples, st) = read_capture(
+        &serial_bytes(&good, &Header::serial_v1().with("sample_hz", "1000")),
+        false,
+    );
+    assert_eq!(encoder_rows(&samples).len(), 400, "{:?}", st.skips);
+    assert_eq!(st.encoder_period_us, 5000);
+    assert!(
+        st.warnings[0].contains("sample_hz=1000") && st.warnings[0].contains("5000 µs"),
+        "{:?}",
+        st.warnings
+    );
+    let (samples, st) = read_capture(
+        &sd_bytes(&good, &sd_header_200().with("encoder_hz", "1000")),
+        true,
+    );
+    assert_eq!(encoder_rows(&samples).len(), 400, "{:?}", st.skips);
+    assert_eq!(st.gap_count, 0, "{:?}", st.gaps);
+    assert!(
+        st.warnings.len() == 1
+            && st.warnings[0].contains("encoder_hz=1000")
+            && st.warnings[0].contains("5000 µs"),
+        "{:?}",
+        st.warnings
+    );
+    // Within the factor: no warning.
+    let (_, st) = read_capture(
+        &serial_bytes(&good, &Header::serial_v1().with("sample_hz", "150")),
+        false,
+    );
+    assert!(st.warnings.is_empty(), "{:?}", st.warnings);
+
+    // Ingest.
+    let root = tempfile::tempdir().unwrap();
+    let camp = campaign(
+        root.path(),
+        "[[run]]\nid = \"rate\"\nfile = \"rate.csv\"\nrole = \"identify\"\n\
+         [[run]]\nid = \"trail\"\nfile = \"trail.csv\"\nrole = \"identify\"\n\
+         [[run]]\nid = \"junk\"\nfile = \"junk.csv\"\nrole = \"identify\"\n\
+         [[run]]\nid = \"holes\"\nfile = \"holes.csv\"\nrole = \"identify\"\n",
+    );
+    let text_of = |rows: &[Row], h: &Header| String::from_utf8(serial_bytes(rows, h)).unwrap();
+    let plain = text_of(&good, &Header::serial_v1());
+    std::fs::write(
+        camp.join("rate.csv"),
+        text_of(&good, &Header::serial_v1().with("sample_hz", "1000")),
+    )
+    .unwrap();
+    let (head, body) = plain.split_once("t_us,enc,ax,ay,az\n").unwrap();
+    let trailing: String = body.lines().map(|l| format!("{l} \n")).collect();
+    std::fs::write(
+        camp.join("trail.csv"),
+        format!("{head}t_us,enc,ax,ay,az\n{trailing}"),
+    )
+    .unwrap();
+    let junk: String = (0..400).map(|k| format!("@#{k}%&*\n")).collect();
+    std::fs::write(
+        camp.join("junk.csv"),
+        format!("{head}t_us,enc,ax,ay,az\n{junk}"),
+    )
+    .unwrap();
+    // 10 lines kept, then 190 lost, over and over: 5 % of what 200 Hz implies.
+    let long = swing(8000, 1_000_000);
+    let holes: Vec<Row> = long
+        .iter()
+        .enumerate()
+        .filter(|(k, _)| k % 200 < 10)
+        .map(|(_, r)| *r)
+        .collect();
+    std::fs::write(
+        camp.join("holes.csv"),
+        text_of(&holes, &Header::serial_v1()),
+    )
+    .unwrap();
+    let out = root.path().join("out");
+    let o = ingest(&camp, &out);
+    let (stdout, stderr) = text(&o);
+    assert_eq!(o.status.code(), Some(1), "{stdout}{stderr}");
+    assert!(
+        stderr.contains("3 of 4 runs could not be ingested"),
+        "{stderr}"
+    );
+    let row = |id: &str| {
+        stdout
+            .lines()
+            .find(|l| l.starts_with(&format!("{id} ")))
+            .unwrap_or_else(|| panic!("row {id} in {stdout}"))
+            .to_string()
+    };
+    assert!(row("rate").contains(" 400 "), "{stdout}");
+    assert!(
+        stdout.contains("rate: warning: header sample_hz=1000"),
+        "{stdout}"
+    );
+    for (id, why) in [
+        ("trail", "kept 0 encoder samples"),
+        ("junk", "kept 0 encoder samples"),
+        ("holes", "the stream is mostly holes"),
+    ] {
+        let r = row(id);
+        assert!(
+            r.contains("FAILED") && r.contains("failed run") && r.contains(why),
+            "{id}: {r}"
+        );
+        assert!(!out.join(format!("{id}.mcap")).exists(), "{id}: no MCAP");
+    }
+    assert!(out.join("rate.mcap").exists());
+}
+
+/// Script 05: a misspelt `omgea_hz` was kept as metadata without a word, and the shaker run
+/// analysed as a free decay. The key is still kept (rig.md), but a warning names the run, the
+/// key and the key it is probably meant to be; ordinary metadata keys get none.
+#[test]
+fn regression_issue_13_a_misspelt_campaign_key_is_named() {
+    let root = tempfile::tempdir().unwrap();
+    let camp = campaign(
+        root.path(),
+        "[[run]]\nid = \"r01\"\nfile = \"r01.csv\"\nrole = \"identify\"\nomgea_hz = 1.54\n\
+         note = \"fresh grease\"\noperator = \"ann\"\n",
+    );
+    let c = Campaign::load(&camp).unwrap();
+    assert_eq!(c.runs[0].omega_hz, None);
+    assert_eq!(c.runs[0].extra["omgea_hz"].as_float(), Some(1.54));
+    assert_eq!(c.warnings.len(), 1, "{:?}", c.warnings);
+    let out = root.path().join("out");
+    let o = ingest(&camp, &out);
+    let (stdout, stderr) = text(&o);
+    assert!(o.status.success(), "{stdout}{stderr}");
+    assert!(
+        stdout.contains(
+            "run `r01`: unknown key `omgea_hz` (kept as metadata): did you mean `omega_hz`?"
+        ),
+        "{stdout}"
+    );
+    assert!(
+        !stdout.contains("`note`") && !stdout.contains("`operator`"),
+        "{stdout}"
+    );
+    // In the [rig] table too, named as such.
+    std::fs::write(
+        camp.join("campaign.toml"),
+        format!("{GOOD_RIG}rod_l_m = 0.575\n[[run]]\nid = \"r01\"\nfile = \"r01.csv\"\nrole = \"identify\"\n"),
+    )
+    .unwrap();
+    let c = Campaign::load(&camp).unwrap();
+    assert!(
+        c.warnings.len() == 1
+            && c.warnings[0].contains("[rig]: unknown key `rod_l_m`")
+            && c.warnings[0].contains("`rod_L_m`"),
+        "{:?}",
+        c.warnings
     );
 }

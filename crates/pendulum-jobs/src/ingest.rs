@@ -32,10 +32,13 @@ pub struct IngestRow {
 pub struct IngestSummary {
     pub campaign: String,
     pub rows: Vec<IngestRow>,
+    /// The campaign's own warnings (a key that looks misspelt), each naming its run.
+    pub warnings: Vec<String>,
 }
 
 impl IngestSummary {
-    /// Runs that could not be ingested at all.
+    /// Runs that could not be ingested at all, or kept almost nothing
+    /// ([`IngestStats::failure`]).
     pub fn failed(&self) -> usize {
         self.rows.iter().filter(|r| r.error.is_some()).count()
     }
@@ -50,6 +53,9 @@ impl std::fmt::Display for IngestSummary {
             pendulum_rig::names::printable(&self.campaign),
             self.rows.len()
         )?;
+        for w in &self.warnings {
+            writeln!(f, "warning: {w}")?;
+        }
         writeln!(
             f,
             "{:<10} {:<10} {:>9} {:>8} {:>8} {:>8} {:>5} {:>6} {:>6} {:>6}",
@@ -150,6 +156,12 @@ fn stats_json(stats: &IngestStats, format: &str) -> serde_json::Value {
         "clock_wraps": stats.clock_wraps,
         "encoder_wraps": stats.encoder_wraps,
         "truncated_tail_bytes": stats.truncated_tail_bytes,
+        "off_timeline": stats.off_timeline,
+        "duplicates": stats.duplicates,
+        "implausible": stats.implausible,
+        "new_segments": stats.new_segments,
+        "encoder_period_us": stats.encoder_period_us,
+        "warnings": stats.warnings,
         "skips": skips,
         "gap_list": serde_json::to_value(&stats.gaps).unwrap_or_default(),
     })
@@ -226,6 +238,20 @@ fn ingest_run(c: &Campaign, spec: &RunSpec, out_dir: &Path) -> Result<IngestRow,
         }
     }
     let stats = reader.stats().clone();
+    warnings.extend(stats.warnings.iter().cloned());
+    if let Some(why) = stats.failure() {
+        // Dropped unfinished: the writer removes its temporary file, so no near-empty MCAP
+        // takes the final name; the row keeps the stats so that the skips are listed.
+        drop(w);
+        return Ok(IngestRow {
+            run_id: spec.id.clone(),
+            format: reader.format().to_string(),
+            mcap: None,
+            stats: Some(stats),
+            error: Some(format!("{}: failed run: {why}", spec.file.display())),
+            warnings,
+        });
+    }
     w.write_stats(&stats_json(&stats, reader.format()))?;
     let summary = w.finish()?;
     Ok(IngestRow {
@@ -315,5 +341,6 @@ pub fn run(dir: &Path, out_dir: &Path, show_progress: bool) -> Result<IngestSumm
     Ok(IngestSummary {
         campaign: c.name.clone(),
         rows,
+        warnings: c.warnings.clone(),
     })
 }

@@ -30,6 +30,17 @@ pub fn read_capture(spec: &RunSpec, g_m_s2: f64) -> Result<ReadCapture, JobError
     while let Some(s) = reader.next_sample()? {
         samples.push(s);
     }
+    // The rule `pendulum ingest` applies: a run that kept almost nothing is no run to fit.
+    if let Some(why) = reader.stats().failure() {
+        return Err(JobError::Invalid(format!(
+            "{}: run `{}`: failed run: {why}",
+            spec.file.display(),
+            spec.id
+        )));
+    }
+    for w in &reader.stats().warnings {
+        eprintln!("warning: run `{}`: {w}", spec.id);
+    }
     Ok(ReadCapture {
         format: reader.format(),
         header: reader.header().entries.clone(),
@@ -229,11 +240,16 @@ pub fn source(dir: &Path) -> Result<Source, JobError> {
 pub fn load_runs(dir: &Path) -> Result<Vec<RunData>, JobError> {
     use rayon::prelude::*;
     match source(dir)? {
-        Source::Campaign(c) => c
-            .runs
-            .par_iter()
-            .map(|spec| read_capture(spec, c.g_m_s2).map(|cap| run_data(&c, spec, &cap)))
-            .collect(),
+        Source::Campaign(c) => {
+            // Before any work: a misspelt key changes what a run is taken for.
+            for w in &c.warnings {
+                eprintln!("warning: {w}");
+            }
+            c.runs
+                .par_iter()
+                .map(|spec| read_capture(spec, c.g_m_s2).map(|cap| run_data(&c, spec, &cap)))
+                .collect()
+        }
         Source::Mcap(files) => files
             .par_iter()
             .map(|p| run_data_from_log(&read_run(p)?))

@@ -455,9 +455,15 @@ pub fn spec_for_runs(
         return Ok(spec);
     }
     if n_free < runs.len() {
+        let free: Vec<&str> = runs
+            .iter()
+            .filter(|r| r.free)
+            .map(|r| r.id.as_str())
+            .collect();
         return Err(bad(format!(
-            "{n_free} of {} runs are free decays (no shaker): fit free decays and shaker runs separately",
-            runs.len()
+            "{n_free} of {} runs are free decays (no shaker: no omega_hz): {}; fit free decays and shaker runs separately",
+            runs.len(),
+            free.join(", ")
         )));
     }
     spec.free_decay().map_err(bad)

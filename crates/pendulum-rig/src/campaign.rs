@@ -71,6 +71,63 @@ pub struct Campaign {
     pub runs: Vec<RunSpec>,
     /// Unknown top-level keys.
     pub extra: BTreeMap<String, Value>,
+    /// Unknown keys so close to a known one that they are probably a misspelling of it (see
+    /// [`suggest_key`]), each naming the file, the run (or `[rig]`) and the suggestion. The key
+    /// is still kept as metadata, as rig.md requires; the user is told.
+    pub warnings: Vec<String>,
+}
+
+/// Top-level keys the program reads.
+const TOP_KEYS: [&str; 4] = ["name", "g_m_s2", "rig", "run"];
+
+/// The known key an unknown `key` is probably a misspelling of: at most 2 edits away (a
+/// transposition counts as one: `omgea_hz`), 1 for keys of 4 characters or fewer so that
+/// ordinary short metadata keys are not taken for one (rig.md's own `note` is 2 edits from
+/// `role`). `None` when no known key is that close, or the key is itself known.
+pub fn suggest_key<'a>(key: &str, known: impl IntoIterator<Item = &'a str>) -> Option<&'a str> {
+    let mut best: Option<(usize, &str)> = None;
+    for k in known {
+        if k == key {
+            return None;
+        }
+        let d = edit_distance(key, k);
+        let limit = if k.chars().count().min(key.chars().count()) <= 4 {
+            1
+        } else {
+            2
+        };
+        if d <= limit && best.is_none_or(|(bd, _)| d < bd) {
+            best = Some((d, k));
+        }
+    }
+    best.map(|(_, k)| k)
+}
+
+/// Optimal-string-alignment distance: insertions, deletions, substitutions and transpositions
+/// of neighbours each count 1.
+fn edit_distance(a: &str, b: &str) -> usize {
+    let a: Vec<char> = a.chars().collect();
+    let b: Vec<char> = b.chars().collect();
+    let mut d = vec![vec![0usize; b.len() + 1]; a.len() + 1];
+    for (i, row) in d.iter_mut().enumerate() {
+        row[0] = i;
+    }
+    for (j, cell) in d[0].iter_mut().enumerate() {
+        *cell = j;
+    }
+    for i in 1..=a.len() {
+        for j in 1..=b.len() {
+            let cost = usize::from(a[i - 1] != b[j - 1]);
+            let mut v = (d[i - 1][j] + 1)
+                .min(d[i][j - 1] + 1)
+                .min(d[i - 1][j - 1] + cost);
+            if i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1] {
+                v = v.min(d[i - 2][j - 2] + 1);
+            }
+            d[i][j] = v;
+        }
+    }
+    d[a.len()][b.len()]
 }
 
 const RUN_KEYS: [&str; 10] = [
@@ -148,6 +205,42 @@ impl Campaign {
             Some(_) => return Err(key_err(None, "run", "an array of tables [[run]]")),
         };
         let extra: BTreeMap<String, Value> = table.into_iter().collect();
+        let run_keys = || {
+            RUN_KEYS
+                .iter()
+                .chain(crate::timeseries::TIMESERIES_KEYS.iter())
+                .copied()
+        };
+        let mut warnings = Vec::new();
+        let mut warn = |scope: &str, key: &str, known: &str| {
+            warnings.push(format!(
+                "{}: {scope}unknown key `{}` (kept as metadata): did you mean `{known}`?",
+                path.display(),
+                names::printable(key)
+            ));
+        };
+        for k in extra.keys() {
+            if let Some(known) = suggest_key(k, TOP_KEYS.iter().copied().chain(run_keys())) {
+                warn("", k, known);
+            }
+        }
+        for k in rig.keys() {
+            if let Some(known) = suggest_key(k, run_keys()) {
+                warn("[rig]: ", k, known);
+            }
+        }
+        for (i, v) in run_values.iter().enumerate() {
+            let Value::Table(t) = v else { continue };
+            let label = match t.get("id") {
+                Some(Value::String(s)) if names::check_run_id(s).is_ok() => s.clone(),
+                _ => format!("run #{}", i + 1),
+            };
+            for k in t.keys() {
+                if let Some(known) = suggest_key(k, run_keys()) {
+                    warn(&format!("run `{label}`: "), k, known);
+                }
+            }
+        }
 
         let mut runs = Vec::with_capacity(run_values.len());
         let mut ids = BTreeSet::new();
@@ -175,6 +268,7 @@ impl Campaign {
             rig,
             runs,
             extra,
+            warnings,
         })
     }
 
@@ -510,6 +604,21 @@ format = "sd-v2"
             RigError::CampaignSyntax { line, .. } => assert_eq!(line, 14),
             e => panic!("{e}"),
         }
+    }
+
+    #[test]
+    fn suggests_close_known_keys_only() {
+        let known = || RUN_KEYS.iter().copied();
+        assert_eq!(suggest_key("omgea_hz", known()), Some("omega_hz"));
+        assert_eq!(suggest_key("omega_Hz", known()), Some("omega_hz"));
+        assert_eq!(suggest_key("crank_rm", known()), Some("crank_r_m"));
+        assert_eq!(suggest_key("omega_hz", known()), None);
+        // rig.md's own metadata keys are not misspellings.
+        for k in ["note", "operator", "bearing", "shaker", "lab", "seed"] {
+            assert_eq!(suggest_key(k, known()), None, "{k}");
+        }
+        assert_eq!(edit_distance("", "abc"), 3);
+        assert_eq!(edit_distance("ab", "ba"), 1);
     }
 
     #[test]

@@ -280,19 +280,48 @@ pub struct IngestStats {
     pub encoder_wraps: u64,
     /// Bytes of a frame cut by the end of the file (power cut).
     pub truncated_tail_bytes: u64,
+    /// Records dropped because their stamps left the timeline for a short run while the
+    /// majority of the records carried on (stale or future-stamped blocks, duplicated chunks);
+    /// each is also a skip.
+    pub off_timeline: u64,
+    /// Of `off_timeline`, the exact copies (stamp and values) of another record.
+    pub duplicates: u64,
+    /// Records dropped because a value moved faster than the pendulum or the shaker can
+    /// ([`MAX_ENCODER_REV_PER_S`], [`MAX_SHAKER_JERK_M_S3`]); each is also a skip.
+    pub implausible: u64,
+    /// Places where the board clock restarted (a reset) or the stamps moved for good: the
+    /// timeline was re-anchored there and a new segment started (also in `warnings`).
+    pub new_segments: u64,
+    /// Bytes of the records kept (serial lines, SD frames): with `skipped_bytes`, how much of
+    /// the data was usable. 0 when the reader does not count them.
+    pub kept_bytes: u64,
+    /// The encoder sample period the reader used (µs): the header's, or the measured median
+    /// step when the two disagree (see [`RATE_MISMATCH_FACTOR`]). 0 when unknown.
+    pub encoder_period_us: u64,
+    /// Unwrapped time of the first and last kept encoder samples.
+    pub encoder_first_t_us: Option<u64>,
+    pub encoder_last_t_us: Option<u64>,
+    /// Things the reader noticed and acted on without dropping data (a header rate that the
+    /// stamps contradict, a new segment); the first [`MAX_SKIPS_KEPT`].
+    pub warnings: Vec<String>,
 }
 
 impl IngestStats {
     /// One line for logs and reports.
     pub fn summary(&self) -> String {
         format!(
-            "{} encoder + {} accel samples; {} lines/frames skipped ({} bytes); {} gaps; \
+            "{} encoder + {} accel samples; {} lines/frames skipped ({} bytes; {} off the \
+             timeline, {} of them duplicates; {} implausible values); {} gaps; {} new segments; \
              {} clock wraps; {} encoder wraps; {} truncated tail bytes",
             self.encoder_samples,
             self.accel_samples,
             self.skipped_lines_or_frames,
             self.skipped_bytes,
+            self.off_timeline,
+            self.duplicates,
+            self.implausible,
             self.gap_count,
+            self.new_segments,
             self.clock_wraps,
             self.encoder_wraps,
             self.truncated_tail_bytes
@@ -315,6 +344,63 @@ impl IngestStats {
                 },
             );
         }
+    }
+
+    /// Records a warning (the first [`MAX_SKIPS_KEPT`] are kept).
+    pub(crate) fn warn(&mut self, w: String) {
+        if self.warnings.len() < MAX_SKIPS_KEPT {
+            self.warnings.push(w);
+        }
+    }
+
+    /// Notes a kept encoder sample's time (for [`IngestStats::failure`]).
+    pub(crate) fn kept_encoder(&mut self, t_us: u64) {
+        self.encoder_samples += 1;
+        self.encoder_first_t_us.get_or_insert(t_us);
+        self.encoder_last_t_us = Some(t_us);
+    }
+
+    /// Why the capture is a failed run, or `None` if it kept enough to be one.
+    ///
+    /// A run holds tens of seconds to minutes of samples (rig.md), so one that keeps almost
+    /// nothing is a failure to report, never an empty MCAP with exit 0. Failed when:
+    /// - it kept fewer than 2 encoder samples (nothing to analyse);
+    /// - it kept less than [`MIN_KEPT_FRACTION`] of its data bytes (the rest was damage); or
+    /// - the kept encoder samples are fewer than [`MIN_KEPT_FRACTION`] of what their time span
+    ///   implies at the sample rate used (the stream is mostly holes).
+    ///
+    /// The same rule for both rig readers; the fractions are skipped when a reader does not
+    /// count bytes or knows no rate.
+    pub fn failure(&self) -> Option<String> {
+        if self.encoder_samples < 2 {
+            return Some(format!(
+                "kept {} encoder samples: nothing left to analyse ({} lines/frames, {} bytes skipped as damaged)",
+                self.encoder_samples, self.skipped_lines_or_frames, self.skipped_bytes
+            ));
+        }
+        let data_bytes = self.kept_bytes + self.skipped_bytes;
+        if self.kept_bytes > 0 && (self.kept_bytes as f64) < MIN_KEPT_FRACTION * data_bytes as f64 {
+            return Some(format!(
+                "kept {} of {data_bytes} data bytes ({:.1} %): the rest was damaged ({} lines/frames skipped)",
+                self.kept_bytes,
+                100.0 * self.kept_bytes as f64 / data_bytes as f64,
+                self.skipped_lines_or_frames
+            ));
+        }
+        if let (Some(a), Some(b)) = (self.encoder_first_t_us, self.encoder_last_t_us) {
+            if let Some(steps) = b.saturating_sub(a).checked_div(self.encoder_period_us) {
+                let implied = steps + 1;
+                if (self.encoder_samples as f64) < MIN_KEPT_FRACTION * implied as f64 {
+                    return Some(format!(
+                        "kept {} encoder samples over {:.3} s, where a sample every {} µs implies {implied}: the stream is mostly holes",
+                        self.encoder_samples,
+                        (b - a) as f64 * 1e-6,
+                        self.encoder_period_us
+                    ));
+                }
+            }
+        }
+        None
     }
 
     fn gap(&mut self, gap: Gap) {
@@ -383,6 +469,258 @@ pub(crate) struct OrderRule {
 /// steady stream.
 pub(crate) const CONFIRM_RECORDS: usize = 3;
 
+/// A run that keeps less than this fraction of its data (bytes, or samples its span implies)
+/// failed ([`IngestStats::failure`]). Damage on a working link costs a few per cent; a capture
+/// that lost 90 % is not a run to fit, whatever survived.
+pub const MIN_KEPT_FRACTION: f64 = 0.1;
+
+/// A header rate and the measured median step disagree when they differ by more than this
+/// factor. The firmware's rates are crystal-timed (well under 1 %) and the stamps jitter by
+/// tens of µs on 1–5 ms, so any real disagreement is the header being wrong (edited, or from
+/// another build), never timing. 1.5 stays clear of that and of a lossy link (the median step
+/// is still the period while fewer than half the steps span a gap), and catches a wrong rate
+/// well before it breaks the order check, which accepts lone steps up to `gap_factor` (3)
+/// periods.
+pub const RATE_MISMATCH_FACTOR: f64 = 1.5;
+
+/// Records read ahead at the start to measure the median step (0.6 s of serial lines, about
+/// 0.1 s of SD frames with some 20 accelerometer ones).
+pub(crate) const RATE_PROBE_RECORDS: usize = 128;
+
+/// Fewer measured steps than this: the rate is not checked (a tiny or mostly broken capture).
+const RATE_PROBE_MIN_STEPS: usize = 8;
+
+/// How many records are read ahead to decide a jump of the clock (ahead or back): whether the
+/// earlier timeline comes back within them (then the jump is a short minority, dropped) or not
+/// (then the new timeline is the evidence). A bad SD sector is 512 B, at most 46 frames; a
+/// terminal program's repeated buffer is a few KB, ~100 lines. 512 records cover ten of
+/// either, in ~20 KB.
+pub(crate) const TIMELINE_WINDOW: usize = 512;
+
+/// A clock that jumps to below this after running (and holds there steadily) restarted: the
+/// board was reset. The board counts µs from power-on and logs within a second or two of it.
+pub const RESET_NEAR_ZERO_US: u32 = 10_000_000;
+
+/// The fastest the pendulum can turn, in revolutions per second, for the plausibility of an
+/// encoder step. From rig.md's rig, the shaker can drive at most a rotation at the crank's top
+/// speed (2πΩ = 14.8 rad/s at Ω = 2.36 Hz) plus the speed gained falling over the top against
+/// the largest base acceleration (r ω² (1 + λ) = 61 m/s² at r = 0.205 m, L = 0.575 m) on the
+/// shortest arm (l = 0.17 m): sqrt(ω² + 4 (g + ÿ_max) / l) = 43 rad/s = 6.9 rev/s. The operator
+/// may spin it faster by hand before the shaker starts: the twin's hand spin that wraps the
+/// 16-bit count is 75 rad/s (11.9 rev/s). 25 rev/s (157 rad/s, 102 counts per ms, 512 per 5 ms)
+/// is twice that; a garbled digit (8,000 counts in 5 ms: 390 rev/s) is far outside.
+pub const MAX_ENCODER_REV_PER_S: f64 = 25.0;
+
+/// Counts always allowed between two encoder samples on top of the speed bound: the
+/// quantisation (±1) and a little stamp jitter.
+const ENCODER_SLACK_COUNTS: f64 = 2.0;
+
+/// The fastest the table's acceleration can change, m/s³, for the plausibility of an
+/// accelerometer step: the crank-rod's largest jerk on rig.md's rig (r = 0.205 m, L = 0.575 m,
+/// Ω = 2.36 Hz) is 1,036 m/s³ (0.53 g per 5 ms); doubled for the motor's ramp, the table's
+/// own vibration and an `accel_gain` error.
+pub const MAX_SHAKER_JERK_M_S3: f64 = 2000.0;
+
+/// Accelerometer change always allowed between two samples, in g: the sensor noise (400 µg/√Hz
+/// to 44 Hz is 3.3 mg rms) many times over.
+const ACCEL_SLACK_G: f64 = 0.05;
+
+/// Whether an encoder count can move by `d_counts` in `dt_us` (see [`MAX_ENCODER_REV_PER_S`]).
+pub(crate) fn encoder_step_plausible(d_counts: i64, dt_us: i64, cpr: u32) -> bool {
+    let dt_s = dt_us.max(0) as f64 * 1e-6;
+    let max = MAX_ENCODER_REV_PER_S * f64::from(cpr.max(1)) * dt_s + ENCODER_SLACK_COUNTS;
+    (d_counts.abs() as f64) <= max
+}
+
+/// Whether raw accelerometer values can move from `a` to `b` in `dt_us` (see
+/// [`MAX_SHAKER_JERK_M_S3`]); `lsb_per_g` converts, `g_m_s2` is g.
+pub(crate) fn accel_step_plausible(
+    a: [i16; 3],
+    b: [i16; 3],
+    dt_us: i64,
+    lsb_per_g: f64,
+    g_m_s2: f64,
+) -> bool {
+    let dt_s = dt_us.max(0) as f64 * 1e-6;
+    let max_g = MAX_SHAKER_JERK_M_S3 * dt_s / g_m_s2.max(1e-9) + ACCEL_SLACK_G;
+    let max = max_g * lsb_per_g;
+    (0..3).all(|i| (f64::from(b[i]) - f64::from(a[i])).abs() <= max)
+}
+
+/// Whether the value of `cand` is a glitch, given the last kept value of its stream (`prev`)
+/// and the next ones (`next`, not yet judged), each `(raw t_us, value)`; `ok(x, y)` says
+/// whether `y` can follow `x`.
+///
+/// The majority of the evidence decides, as for times: a candidate that `prev` cannot reach
+/// is a glitch when the following values side with `prev` at least as often as with it (a lone
+/// implausible value at the end of the file too); when they side with the candidate, the
+/// stream really moved (or `prev` was the odd one) and it is kept. A first value is dropped
+/// only when its followers agree with each other and not with it.
+pub(crate) fn value_glitch<V: Copy>(
+    prev: Option<(u32, V)>,
+    cand: (u32, V),
+    next: &[(u32, V)],
+    ok: impl Fn((u32, V), (u32, V)) -> bool,
+) -> bool {
+    match prev {
+        Some(p) => {
+            if ok(p, cand) {
+                return false;
+            }
+            let with_prev = next.iter().filter(|&&n| ok(p, n)).count();
+            let with_cand = next.iter().filter(|&&n| ok(cand, n)).count();
+            with_prev >= with_cand
+        }
+        None => match next {
+            [a, b, ..] => !ok(cand, *a) && ok(*a, *b),
+            _ => false,
+        },
+    }
+}
+
+/// The sample period one stream's stamps show, checked against the header's.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct RateCheck {
+    /// The period to use, µs: the header's, or the measured one when they disagree.
+    pub period_us: f64,
+    /// Set when they disagree: what to tell the user.
+    pub warning: Option<String>,
+}
+
+/// Compares a header's declared rate (`key` = `declared_hz`) with the median of the measured
+/// positive steps of one stream (µs). Both readers use this rule, per stream.
+pub(crate) fn check_rate(
+    key: &str,
+    declared_hz: f64,
+    mut steps_us: Vec<i64>,
+    what: &str,
+) -> RateCheck {
+    let declared_us = 1e6 / declared_hz;
+    // Steps of a second or more are gaps or garbage, not the rate.
+    steps_us.retain(|&s| s > 0 && s < 1_000_000);
+    if steps_us.len() < RATE_PROBE_MIN_STEPS {
+        return RateCheck {
+            period_us: declared_us,
+            warning: None,
+        };
+    }
+    steps_us.sort_unstable();
+    let median = steps_us[steps_us.len() / 2] as f64;
+    let ratio = median / declared_us;
+    if (1.0 / RATE_MISMATCH_FACTOR..=RATE_MISMATCH_FACTOR).contains(&ratio) {
+        return RateCheck {
+            period_us: declared_us,
+            warning: None,
+        };
+    }
+    RateCheck {
+        period_us: median,
+        warning: Some(format!(
+            "header {key}={declared_hz} says a {what} sample every {declared_us:.0} µs, but the median step of the first {} is {median:.0} µs ({:.1} Hz), off by more than ×{RATE_MISMATCH_FACTOR}: the measured rate is used",
+            steps_us.len() + 1,
+            1e6 / median
+        )),
+    }
+}
+
+/// What [`Lookahead::pop_judged`] decided about a record's time.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) enum Timeline {
+    /// It follows the timeline (or a believed gap).
+    Keep,
+    /// The stamps moved for good here: keep it as the first record of a new segment;
+    /// `reset` when the clock restarted near zero (a board reset).
+    NewSegment { reset: bool },
+    /// Dropped: why, and whether it is off the timeline (a short minority run) and an exact
+    /// copy of another record.
+    Drop {
+        reason: String,
+        off_timeline: bool,
+        duplicate: bool,
+    },
+}
+
+impl Timeline {
+    fn drop(reason: impl Into<String>) -> Self {
+        Timeline::Drop {
+            reason: reason.into(),
+            off_timeline: false,
+            duplicate: false,
+        }
+    }
+}
+
+/// A record as the timeline judgement sees it.
+pub(crate) trait Record {
+    /// Raw board time.
+    fn t_raw(&self) -> u32;
+    fn at(&self) -> Location;
+    /// The record's values (not its time), to recognise exact copies.
+    fn fingerprint(&self) -> u64;
+}
+
+/// How many kept (and dropped) records [`Recent`] remembers: 40 s of serial lines, 8 s of SD
+/// frames, ~0.5 MB.
+const RECENT_RECORDS: usize = 8192;
+
+/// Records by stamp and values, forgetting the oldest beyond [`RECENT_RECORDS`].
+#[derive(Debug, Default)]
+struct Remembered {
+    map: std::collections::HashMap<(u32, u64), Location>,
+    order: std::collections::VecDeque<(u32, u64)>,
+}
+
+impl Remembered {
+    fn insert(&mut self, key: (u32, u64), at: Location) {
+        if self.order.len() == RECENT_RECORDS {
+            if let Some(old) = self.order.pop_front() {
+                self.map.remove(&old);
+            }
+        }
+        if self.map.insert(key, at).is_none() {
+            self.order.push_back(key);
+        }
+    }
+
+    fn clear(&mut self) {
+        self.map.clear();
+        self.order.clear();
+    }
+}
+
+/// The last records kept, to recognise a duplicated chunk that comes back after its original,
+/// and the last ones dropped off the timeline, to recognise a copy that came before its
+/// original once the original arrives.
+#[derive(Debug, Default)]
+pub(crate) struct Recent {
+    kept: Remembered,
+    dropped: Remembered,
+}
+
+impl Recent {
+    /// Remembers a kept record; true if it is the original of a copy dropped earlier (then
+    /// that copy is a duplicate).
+    pub(crate) fn push_kept(&mut self, r: &impl Record) -> bool {
+        let key = (r.t_raw(), r.fingerprint());
+        self.kept.insert(key, r.at());
+        self.dropped.map.remove(&key).is_some()
+    }
+
+    /// Remembers a record dropped off the timeline that was not recognised as a copy.
+    pub(crate) fn push_dropped(&mut self, r: &impl Record) {
+        self.dropped.insert((r.t_raw(), r.fingerprint()), r.at());
+    }
+
+    fn find(&self, r: &impl Record) -> Option<Location> {
+        self.kept.map.get(&(r.t_raw(), r.fingerprint())).copied()
+    }
+
+    pub(crate) fn clear(&mut self) {
+        self.kept.clear();
+        self.dropped.clear();
+    }
+}
+
 /// The records after a candidate that [`check_order`] looks at, read ahead from a capture's
 /// record source (the serial and SD readers share it).
 #[derive(Debug)]
@@ -404,11 +742,17 @@ impl<T> Default for Lookahead<T> {
 impl<T> Lookahead<T> {
     /// Reads records until the next candidate and [`CONFIRM_RECORDS`] followers are in (fewer
     /// at the end of the source).
-    pub(crate) fn fill<E>(
+    pub(crate) fn fill<E>(&mut self, read: impl FnMut() -> Result<Option<T>, E>) -> Result<(), E> {
+        self.fill_to(CONFIRM_RECORDS + 1, read)
+    }
+
+    /// Reads records until `n` are buffered (fewer at the end of the source).
+    pub(crate) fn fill_to<E>(
         &mut self,
+        n: usize,
         mut read: impl FnMut() -> Result<Option<T>, E>,
     ) -> Result<(), E> {
-        while self.buf.len() <= CONFIRM_RECORDS && !self.drained {
+        while self.buf.len() < n && !self.drained {
             match read()? {
                 Some(x) => self.buf.push_back(x),
                 None => self.drained = true,
@@ -417,22 +761,155 @@ impl<T> Lookahead<T> {
         Ok(())
     }
 
-    /// The next candidate (None at the end) with [`check_order`]'s verdict on its raw time
-    /// `t_us`, given the last kept record's `prev` and the followers read ahead.
-    pub(crate) fn pop_checked(
+    /// The records read ahead, the next candidate first.
+    pub(crate) fn iter(&self) -> impl Iterator<Item = &T> {
+        self.buf.iter()
+    }
+}
+
+impl<T: Record> Lookahead<T> {
+    /// Whether the next candidate jumps (ahead beyond a lone step, or back) from `prev`: then
+    /// [`TIMELINE_WINDOW`] records must be read ahead before [`Lookahead::pop_judged`].
+    pub(crate) fn front_jumps(&self, prev: Option<u32>, rule: OrderRule) -> bool {
+        match (prev, self.buf.front()) {
+            (Some(p), Some(c)) => {
+                let s = signed_step(p, c.t_raw());
+                s < rule.min_step_us || s > rule.max_lone_step_us
+            }
+            _ => false,
+        }
+    }
+
+    /// The next candidate (None at the end) with the verdict on its time, given the last kept
+    /// record's raw time `prev` and the records read ahead ([`Lookahead::front_jumps`] says
+    /// when the whole window is needed), and the recently kept records.
+    ///
+    /// An ordinary step is judged by [`check_order`]. A jump, ahead or back, is judged by the
+    /// majority of the evidence in the window:
+    /// - a copy (stamp and values) of a recently kept record is a duplicated chunk: dropped;
+    /// - if the earlier timeline comes back within the window (a record that continues from
+    ///   `prev`, followed steadily), the jump is a short minority (a stale or future-stamped
+    ///   block, a chunk repeated out of place): dropped, whatever its own consistency;
+    /// - otherwise, if the candidate starts a steady run, the stamps really moved: a jump ahead
+    ///   is a gap (kept), a jump back or a restart near zero a new segment;
+    /// - otherwise the candidate is a lone damaged record: dropped.
+    pub(crate) fn pop_judged(
         &mut self,
-        t_us: impl Fn(&T) -> u32,
         prev: Option<u32>,
         rule: OrderRule,
-    ) -> Option<(T, Result<(), &'static str>)> {
+        recent: &Recent,
+    ) -> Option<(T, Timeline)> {
         let cand = self.buf.pop_front()?;
+        let c = cand.t_raw();
         let mut next = [0u32; CONFIRM_RECORDS];
         let k = self.buf.len().min(CONFIRM_RECORDS);
         for (slot, x) in next.iter_mut().zip(&self.buf) {
-            *slot = t_us(x);
+            *slot = x.t_raw();
         }
-        let verdict = check_order(prev, t_us(&cand), &next[..k], rule);
+        let verdict = match prev {
+            Some(p)
+                if {
+                    let s = signed_step(p, c);
+                    s < rule.min_step_us || s > rule.max_lone_step_us
+                } =>
+            {
+                self.judge_jump(p, &cand, rule, recent)
+            }
+            _ => match check_order(prev, c, &next[..k], rule) {
+                Ok(()) => Timeline::Keep,
+                Err(why) => Timeline::drop(why),
+            },
+        };
         Some((cand, verdict))
+    }
+
+    fn judge_jump(&self, p: u32, cand: &T, rule: OrderRule, recent: &Recent) -> Timeline {
+        let c = cand.t_raw();
+        let step = signed_step(p, c);
+        let behind = step < rule.min_step_us;
+        let ordinary = |a: u32, b: u32| {
+            let s = signed_step(a, b);
+            s >= rule.min_step_us && s <= rule.max_lone_step_us
+        };
+        let off = |why: String, duplicate: bool| Timeline::Drop {
+            reason: why,
+            off_timeline: true,
+            duplicate,
+        };
+        let shift = format!("{:+.6} s", step as f64 * 1e-6);
+        if behind {
+            if let Some(at) = recent.find(cand) {
+                return off(
+                    format!("repeats the record kept at {at} (a duplicated chunk; t_us={c})"),
+                    true,
+                );
+            }
+        }
+        // Steady from index i of the window: its next records step ordinarily (fewer at the
+        // end of the file; none needed for the last record of the file).
+        let steady_from = |i: usize| {
+            let mut last = self.buf[i].t_raw();
+            for x in self.buf.iter().skip(i + 1).take(CONFIRM_RECORDS) {
+                if !ordinary(last, x.t_raw()) {
+                    return false;
+                }
+                last = x.t_raw();
+            }
+            self.drained || self.buf.len() > i + CONFIRM_RECORDS
+        };
+        for (i, x) in self.buf.iter().enumerate() {
+            let s = signed_step(p, x.t_raw());
+            // Records lost while the damage lasted widen how far on the earlier timeline may
+            // resume; a record lying between `prev` and a jump ahead is on it.
+            let on_earlier = if behind {
+                s >= rule.min_step_us && s <= rule.max_lone_step_us.saturating_mul(i as i64 + 2)
+            } else {
+                s >= rule.min_step_us && signed_step(x.t_raw(), c) > rule.max_lone_step_us
+            };
+            if on_earlier && steady_from(i) {
+                let copy = self
+                    .buf
+                    .iter()
+                    .find(|y| y.t_raw() == c && y.fingerprint() == cand.fingerprint())
+                    .map(|y| y.at());
+                let what = if copy.is_some() {
+                    " (a copy of a record further on: a duplicated chunk)"
+                } else {
+                    ""
+                };
+                return off(
+                    format!(
+                        "stamped {shift} off the timeline, which resumes at {}{what} (t_us={c})",
+                        x.at()
+                    ),
+                    copy.is_some(),
+                );
+            }
+        }
+        let confirmed = !self.buf.is_empty() && {
+            let mut last = c;
+            self.buf.iter().take(CONFIRM_RECORDS).all(|x| {
+                let ok = ordinary(last, x.t_raw());
+                last = x.t_raw();
+                ok
+            })
+        };
+        if !confirmed {
+            return Timeline::drop(if behind {
+                "time goes backwards"
+            } else {
+                "time jumps ahead and the next records do not follow"
+            });
+        }
+        // Far beyond a wrap's reach yet near zero: the clock restarted (a genuine wrap lands
+        // near zero only from near the top, a short step).
+        let restarted =
+            c < RESET_NEAR_ZERO_US && (behind || step > 2 * i64::from(RESET_NEAR_ZERO_US));
+        if behind || restarted {
+            Timeline::NewSegment { reset: restarted }
+        } else {
+            Timeline::Keep
+        }
     }
 }
 
@@ -520,6 +997,27 @@ impl Clock {
         }
     }
 
+    /// Where a new segment starting at raw time `raw` goes on the unwrapped timeline: after
+    /// the last record by the time since a reset (`raw` counts from the board's power-on, so
+    /// the hole is at least that long), or by one `period_us` when the stamps merely moved.
+    pub(crate) fn reanchor_t(&self, raw: u32, reset: bool, period_us: u64) -> u64 {
+        let last = u64::try_from(self.last_t).unwrap_or(0);
+        let after = if reset {
+            u64::from(raw).max(period_us)
+        } else {
+            period_us
+        };
+        last.saturating_add(after.max(1))
+    }
+
+    /// Continues the timeline from a new segment's first record (no clock wrap is counted).
+    pub(crate) fn reanchor(&mut self, raw: u32, t_us: u64) {
+        let t = i64::try_from(t_us).unwrap_or(i64::MAX);
+        self.last_raw = Some(raw);
+        self.last_t = t;
+        self.max_t = self.max_t.max(t);
+    }
+
     pub(crate) fn commit(&mut self, raw: u32, t_us: u64, stats: &mut IngestStats) {
         let t = i64::try_from(t_us).unwrap_or(i64::MAX);
         if self.last_raw.is_none() {
@@ -542,6 +1040,11 @@ pub(crate) struct Counter {
 }
 
 impl Counter {
+    /// The board powered on again: its count restarted from zero where the pendulum was.
+    pub(crate) fn restart(&mut self) {
+        self.last_raw = None;
+    }
+
     /// The difference is taken mod 2^16 into [−32768, 32767]: a jump of 2^15 counts between two
     /// samples (half of 8 revolutions in 1–5 ms) is physically impossible.
     pub(crate) fn step(&mut self, raw: i16, stats: &mut IngestStats) -> i64 {
@@ -582,6 +1085,10 @@ impl GapTracker {
 
     pub(crate) fn last_t(&self) -> Option<u64> {
         self.last_t
+    }
+
+    pub(crate) fn set_period_us(&mut self, period_us: f64) {
+        self.period_us = period_us;
     }
 
     pub(crate) fn step(&mut self, t_us: u64, stats: &mut IngestStats) {

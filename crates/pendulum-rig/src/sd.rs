@@ -8,8 +8,10 @@ use std::io::{self, Read, Write};
 use std::path::{Path, PathBuf};
 
 use crate::capture::{
-    accel_si, theta_rad, AccelSample, Clock, Counter, EncoderSample, GapTracker, Header,
-    IngestStats, Location, Lookahead, OrderRule, ReadOptions, Sample,
+    accel_si, accel_step_plausible, check_rate, encoder_step_plausible, signed_step, theta_rad,
+    value_glitch, AccelSample, Clock, Counter, EncoderSample, GapTracker, Header, IngestStats,
+    Location, Lookahead, OrderRule, ReadOptions, Recent, Record, Sample, Timeline, CONFIRM_RECORDS,
+    RATE_PROBE_RECORDS, TIMELINE_WINDOW,
 };
 use crate::crc8::crc8;
 use crate::error::RigError;
@@ -26,12 +28,9 @@ pub const FRAME_OVERHEAD: usize = 9;
 /// a few ms before the encoder frame written just before it: steps down to −50 ms between
 /// frames of different streams are still "in order" for outlier rejection.
 const MAX_CROSS_STREAM_SKEW_US: i64 = 50_000;
-/// Encoder speed bound for frames that pass the CRC but are not followed by a sync (see
-/// [`Frame::suspect`]): 128 counts/ms is 31 rev/s, far above anything the pendulum does.
-const MAX_SUSPECT_COUNTS_PER_MS: i64 = 128;
-/// Accelerometer step bound for such frames: 1 g between two samples (the shaker changes the
-/// acceleration by about 0.3 g per 5 ms at most).
-const MAX_SUSPECT_ACCEL_STEP: i32 = 8192;
+/// Records read ahead to find the next frames of a stream when a value looks implausible (the
+/// accelerometer has one frame in six).
+const VALUE_WINDOW: usize = 4 * (CONFIRM_RECORDS + 1);
 const READ_CHUNK: usize = 16 * 1024;
 
 /// Builds one frame. A payload longer than 255 bytes is cut to 255 (the length is one byte).
@@ -84,6 +83,26 @@ impl Frame {
     fn i16_at(&self, i: usize) -> i16 {
         i16::from_le_bytes([self.payload[2 * i], self.payload[2 * i + 1]])
     }
+
+    fn accel(&self) -> [i16; 3] {
+        [self.i16_at(0), self.i16_at(1), self.i16_at(2)]
+    }
+}
+
+impl Record for Frame {
+    fn t_raw(&self) -> u32 {
+        self.t_us
+    }
+
+    fn at(&self) -> Location {
+        Location::Byte(self.offset)
+    }
+
+    fn fingerprint(&self) -> u64 {
+        self.payload
+            .iter()
+            .fold(u64::from(self.kind), |acc, &b| (acc << 8) | u64::from(b))
+    }
 }
 
 /// Bytes being dropped since the last valid frame.
@@ -110,6 +129,13 @@ pub struct SdReader<R: Read> {
     tail_start: Option<u64>,
     finished: bool,
     lookahead: Lookahead<Frame>,
+    /// The rates were checked against the first frames ([`SdReader::probe_rate`]).
+    probed: bool,
+    encoder_period_us: f64,
+    recent: Recent,
+    /// The last kept frame of each stream: raw time and value, for plausibility.
+    last_enc_raw: Option<(u32, i16)>,
+    last_acc_raw: Option<(u32, [i16; 3])>,
     clock: Clock,
     counter: Counter,
     enc_gaps: GapTracker,
@@ -142,6 +168,11 @@ impl<R: Read> SdReader<R> {
             tail_start: None,
             finished: false,
             lookahead: Lookahead::default(),
+            probed: false,
+            encoder_period_us: 1000.0,
+            recent: Recent::default(),
+            last_enc_raw: None,
+            last_acc_raw: None,
             clock: Clock::default(),
             counter: Counter::default(),
             enc_gaps: GapTracker::new("encoder", 1.0, 1.0),
@@ -156,14 +187,61 @@ impl<R: Read> SdReader<R> {
         me.lsb_per_g = me.header.accel_lsb_per_g();
         me.enc_gaps = GapTracker::new("encoder", me.header.encoder_hz(), opts.gap_factor);
         me.acc_gaps = GapTracker::new("accel", me.header.accel_hz(), opts.gap_factor);
-        let slowest_period_us = 1e6 / me.header.encoder_hz().min(me.header.accel_hz());
-        me.order = OrderRule {
+        me.set_periods(1e6 / me.header.encoder_hz(), 1e6 / me.header.accel_hz());
+        Ok(me)
+    }
+
+    fn set_periods(&mut self, encoder_us: f64, accel_us: f64) {
+        self.encoder_period_us = encoder_us;
+        self.stats.encoder_period_us = encoder_us.round() as u64;
+        self.enc_gaps.set_period_us(encoder_us);
+        self.acc_gaps.set_period_us(accel_us);
+        let slowest_period_us = encoder_us.max(accel_us);
+        self.order = OrderRule {
             min_step_us: -MAX_CROSS_STREAM_SKEW_US,
-            period_us: (1e6 / me.header.encoder_hz()).round() as i64,
-            max_lone_step_us: (opts.gap_factor.max(1.0) * slowest_period_us).round() as i64
+            period_us: encoder_us.round() as i64,
+            max_lone_step_us: (self.opts.gap_factor.max(1.0) * slowest_period_us).round() as i64
                 + MAX_CROSS_STREAM_SKEW_US,
         };
-        Ok(me)
+    }
+
+    /// Reads the first [`RATE_PROBE_RECORDS`] frames ahead and checks the header's
+    /// `encoder_hz` and `accel_hz` against each stream's median step ([`check_rate`], the rule
+    /// of the serial reader): when they disagree, the stamps win.
+    fn probe_rate(&mut self) -> Result<(), RigError> {
+        self.probed = true;
+        let mut ahead = std::mem::take(&mut self.lookahead);
+        let filled = ahead.fill_to(RATE_PROBE_RECORDS, || self.next_data_frame());
+        self.lookahead = ahead;
+        filled?;
+        let steps = |kind: u8| -> Vec<i64> {
+            let t: Vec<u32> = self
+                .lookahead
+                .iter()
+                .filter(|f| f.kind == kind)
+                .map(|f| f.t_us)
+                .collect();
+            t.windows(2).map(|w| signed_step(w[0], w[1])).collect()
+        };
+        let enc = check_rate(
+            "encoder_hz",
+            self.header.encoder_hz(),
+            steps(FRAME_ENCODER),
+            "encoder",
+        );
+        let acc = check_rate(
+            "accel_hz",
+            self.header.accel_hz(),
+            steps(FRAME_ACCEL),
+            "accelerometer",
+        );
+        if enc.warning.is_some() || acc.warning.is_some() {
+            for w in [enc.warning, acc.warning].into_iter().flatten() {
+                self.stats.warn(w);
+            }
+            self.set_periods(enc.period_us, acc.period_us);
+        }
+        Ok(())
     }
 
     pub fn header(&self) -> &Header {
@@ -383,7 +461,8 @@ impl<R: Read> SdReader<R> {
         }
     }
 
-    /// Plausibility of a suspect frame next to the last kept sample of its stream.
+    /// Plausibility of a suspect frame next to the last kept sample of its stream (the same
+    /// bounds as [`SdReader::implausible`], without the followers' vote).
     fn plausible(&self, f: &Frame, t_us: u64) -> bool {
         if f.suspect == Suspect::No {
             return true;
@@ -392,54 +471,150 @@ impl<R: Read> SdReader<R> {
         if f.kind == FRAME_ENCODER {
             match self.last_enc {
                 None => alone,
-                Some((t0, c0)) => {
-                    let dt_ms = i64::try_from(t_us.saturating_sub(t0) / 1000).unwrap_or(i64::MAX);
-                    let limit = MAX_SUSPECT_COUNTS_PER_MS.saturating_mul(dt_ms.max(1));
-                    i64::from(f.i16_at(0).wrapping_sub(c0)).abs() <= limit
-                }
+                Some((t0, c0)) => encoder_step_plausible(
+                    i64::from(f.i16_at(0).wrapping_sub(c0)),
+                    i64::try_from(t_us.saturating_sub(t0)).unwrap_or(i64::MAX),
+                    self.cpr,
+                ),
             }
         } else {
             match self.last_acc {
                 None => alone,
-                Some((_, a0)) => (0..3).all(|i| {
-                    (i32::from(f.i16_at(i)) - i32::from(a0[i])).abs() <= MAX_SUSPECT_ACCEL_STEP
-                }),
+                Some((t0, a0)) => accel_step_plausible(
+                    a0,
+                    f.accel(),
+                    i64::try_from(t_us.saturating_sub(t0)).unwrap_or(i64::MAX),
+                    self.lsb_per_g,
+                    self.opts.g_m_s2,
+                ),
             }
         }
+    }
+
+    /// Why a frame whose time is accepted still cannot be believed: its value moved further
+    /// than the pendulum (encoder) or the shaker (accelerometer) can since the last kept frame
+    /// of its stream, while the stream's next frames side with that one ([`value_glitch`], the
+    /// serial reader's rule). `fresh`: the frame starts a new segment.
+    fn implausible(&mut self, cand: &Frame, fresh: bool) -> Result<Option<String>, RigError> {
+        let (cpr, lsb, g) = (self.cpr, self.lsb_per_g, self.opts.g_m_s2);
+        let enc_ok = |a: (u32, i16), b: (u32, i16)| {
+            encoder_step_plausible(i64::from(b.1.wrapping_sub(a.1)), signed_step(a.0, b.0), cpr)
+        };
+        let acc_ok = |a: (u32, [i16; 3]), b: (u32, [i16; 3])| {
+            accel_step_plausible(a.1, b.1, signed_step(a.0, b.0), lsb, g)
+        };
+        let direct_ok = if cand.kind == FRAME_ENCODER {
+            self.last_enc_raw
+                .is_none_or(|p| fresh || enc_ok(p, (cand.t_us, cand.i16_at(0))))
+        } else {
+            self.last_acc_raw
+                .is_none_or(|p| fresh || acc_ok(p, (cand.t_us, cand.accel())))
+        };
+        if direct_ok {
+            return Ok(None);
+        }
+        // The stream's next frames vote.
+        let mut ahead = std::mem::take(&mut self.lookahead);
+        let filled = ahead.fill_to(VALUE_WINDOW, || self.next_data_frame());
+        self.lookahead = ahead;
+        filled?;
+        let same = self
+            .lookahead
+            .iter()
+            .filter(|f| f.kind == cand.kind)
+            .take(CONFIRM_RECORDS);
+        if cand.kind == FRAME_ENCODER {
+            let next: Vec<(u32, i16)> = same.map(|f| (f.t_us, f.i16_at(0))).collect();
+            let c = (cand.t_us, cand.i16_at(0));
+            if value_glitch(self.last_enc_raw, c, &next, enc_ok) {
+                let p = self.last_enc_raw.unwrap_or(c);
+                return Ok(Some(format!(
+                    "encoder value {} moves faster than the pendulum can ({} counts in {} µs): a glitch",
+                    c.1,
+                    i64::from(c.1.wrapping_sub(p.1)),
+                    signed_step(p.0, c.0)
+                )));
+            }
+        } else {
+            let next: Vec<(u32, [i16; 3])> = same.map(|f| (f.t_us, f.accel())).collect();
+            let c = (cand.t_us, cand.accel());
+            if value_glitch(self.last_acc_raw, c, &next, acc_ok) {
+                return Ok(Some(format!(
+                    "accelerometer values {:?} change faster than the shaker can: a glitch",
+                    c.1
+                )));
+            }
+        }
+        Ok(None)
     }
 
     /// The next sample, in file order. Errors only on I/O failure; damage is skipped and
     /// counted in [`Self::stats`].
     pub fn next_sample(&mut self) -> Result<Option<Sample>, RigError> {
+        if !self.probed {
+            self.probe_rate()?;
+        }
         loop {
             // Taken out while it reads, so that the reader can borrow itself.
             let mut ahead = std::mem::take(&mut self.lookahead);
-            let filled = ahead.fill(|| self.next_data_frame());
+            let mut filled = ahead.fill(|| self.next_data_frame());
+            if filled.is_ok() && ahead.front_jumps(self.clock.last_raw(), self.order) {
+                filled = ahead.fill_to(TIMELINE_WINDOW, || self.next_data_frame());
+            }
             self.lookahead = ahead;
             filled?;
             let Some((cand, verdict)) =
                 self.lookahead
-                    .pop_checked(|x| x.t_us, self.clock.last_raw(), self.order)
+                    .pop_judged(self.clock.last_raw(), self.order, &self.recent)
             else {
                 return Ok(None);
             };
             let at = Location::Byte(cand.offset);
-            if let Err(why) = verdict {
-                let reason = format!("frame with valid CRC dropped: {why} (t_us={})", cand.t_us);
-                self.stats.skip(at, reason, cand.len);
-                continue;
-            }
-            let Some(t_us) = self.clock.peek(cand.t_us) else {
-                self.stats
-                    .skip(at, "time before the capture start", cand.len);
-                continue;
+            let segment = match verdict {
+                Timeline::Keep => None,
+                Timeline::NewSegment { reset } => Some(reset),
+                Timeline::Drop {
+                    reason,
+                    off_timeline,
+                    duplicate,
+                } => {
+                    let reason = if off_timeline {
+                        self.stats.off_timeline += 1;
+                        self.stats.duplicates += u64::from(duplicate);
+                        if !duplicate {
+                            self.recent.push_dropped(&cand);
+                        }
+                        format!("frame with valid CRC dropped: {reason}")
+                    } else {
+                        format!(
+                            "frame with valid CRC dropped: {reason} (t_us={})",
+                            cand.t_us
+                        )
+                    };
+                    self.stats.skip(at, reason, cand.len);
+                    continue;
+                }
+            };
+            let t_us = match segment {
+                Some(reset) => {
+                    self.clock
+                        .reanchor_t(cand.t_us, reset, self.encoder_period_us.round() as u64)
+                }
+                None => match self.clock.peek(cand.t_us) {
+                    Some(t) => t,
+                    None => {
+                        self.stats
+                            .skip(at, "time before the capture start", cand.len);
+                        continue;
+                    }
+                },
             };
             let (stream_last, name) = if cand.kind == FRAME_ENCODER {
                 (self.enc_gaps.last_t(), "encoder")
             } else {
                 (self.acc_gaps.last_t(), "accel")
             };
-            if stream_last.is_some_and(|last| t_us <= last) {
+            if segment.is_none() && stream_last.is_some_and(|last| t_us <= last) {
                 let reason = format!("time goes backwards in the {name} stream: garbled");
                 self.stats.skip(at, reason, cand.len);
                 continue;
@@ -451,13 +626,31 @@ impl<R: Read> SdReader<R> {
                 self.stats.skip(at, reason, cand.len);
                 continue;
             }
-            self.clock.commit(cand.t_us, t_us, &mut self.stats);
+            if let Some(why) = self.implausible(&cand, segment.is_some())? {
+                self.stats.implausible += 1;
+                self.stats
+                    .skip(at, format!("frame with valid CRC dropped: {why}"), cand.len);
+                continue;
+            }
+            match segment {
+                Some(reset) => {
+                    self.clock.reanchor(cand.t_us, t_us);
+                    self.start_segment(at, cand.t_us, t_us, reset);
+                }
+                None => self.clock.commit(cand.t_us, t_us, &mut self.stats),
+            }
+            self.stats.kept_bytes += cand.len;
+            if self.recent.push_kept(&cand) {
+                // A copy seen before its original (dropped off the timeline) was a duplicate.
+                self.stats.duplicates += 1;
+            }
             if cand.kind == FRAME_ENCODER {
                 let count_raw = cand.i16_at(0);
                 self.enc_gaps.step(t_us, &mut self.stats);
                 let count = self.counter.step(count_raw, &mut self.stats);
                 self.last_enc = Some((t_us, count_raw));
-                self.stats.encoder_samples += 1;
+                self.last_enc_raw = Some((cand.t_us, count_raw));
+                self.stats.kept_encoder(t_us);
                 return Ok(Some(Sample::Encoder(EncoderSample {
                     t_us_raw: cand.t_us,
                     t_us,
@@ -466,9 +659,10 @@ impl<R: Read> SdReader<R> {
                     theta_rad: theta_rad(count, self.cpr),
                 })));
             }
-            let raw = [cand.i16_at(0), cand.i16_at(1), cand.i16_at(2)];
+            let raw = cand.accel();
             self.acc_gaps.step(t_us, &mut self.stats);
             self.last_acc = Some((t_us, raw));
+            self.last_acc_raw = Some((cand.t_us, raw));
             self.stats.accel_samples += 1;
             return Ok(Some(Sample::Accel(AccelSample {
                 t_us_raw: cand.t_us,
@@ -476,6 +670,26 @@ impl<R: Read> SdReader<R> {
                 raw,
                 si_m_s2: accel_si(raw, self.lsb_per_g, self.opts.g_m_s2),
             })));
+        }
+    }
+
+    /// Bookkeeping of a new segment (see [`Timeline::NewSegment`]): both streams start afresh.
+    fn start_segment(&mut self, at: Location, raw: u32, t_us: u64, reset: bool) {
+        self.stats.new_segments += 1;
+        self.recent.clear();
+        self.last_enc = None;
+        self.last_acc = None;
+        self.last_enc_raw = None;
+        self.last_acc_raw = None;
+        if reset {
+            self.counter.restart();
+            self.stats.warn(format!(
+                "{at}: the board clock restarted (t_us={raw}; a board reset): new segment from unwrapped t_us {t_us}; the encoder count restarts at the board's power-on zero"
+            ));
+        } else {
+            self.stats.warn(format!(
+                "{at}: the clock moved back for good (t_us={raw}): new segment from unwrapped t_us {t_us}"
+            ));
         }
     }
 }

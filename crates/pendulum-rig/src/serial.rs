@@ -8,8 +8,10 @@ use std::io::{self, BufRead, Write};
 use std::path::{Path, PathBuf};
 
 use crate::capture::{
-    accel_si, snippet, theta_rad, AccelSample, Clock, Counter, EncoderSample, GapTracker, Header,
-    IngestStats, Location, Lookahead, OrderRule, ReadOptions, Sample,
+    accel_si, accel_step_plausible, check_rate, encoder_step_plausible, signed_step, snippet,
+    theta_rad, value_glitch, AccelSample, Clock, Counter, EncoderSample, GapTracker, Header,
+    IngestStats, Location, Lookahead, OrderRule, ReadOptions, Recent, Record, Sample, Timeline,
+    CONFIRM_RECORDS, RATE_PROBE_RECORDS, TIMELINE_WINDOW,
 };
 use crate::error::RigError;
 
@@ -28,6 +30,22 @@ struct Row {
     accel: [i16; 3],
 }
 
+impl Record for Row {
+    fn t_raw(&self) -> u32 {
+        self.t_us
+    }
+
+    fn at(&self) -> Location {
+        Location::Line(self.line)
+    }
+
+    fn fingerprint(&self) -> u64 {
+        let v = [self.enc, self.accel[0], self.accel[1], self.accel[2]];
+        v.iter()
+            .fold(0u64, |acc, &x| (acc << 16) | u64::from(x as u16))
+    }
+}
+
 /// Streaming reader of a serial capture.
 pub struct SerialReader<R: BufRead> {
     reader: R,
@@ -40,6 +58,12 @@ pub struct SerialReader<R: BufRead> {
     line_no: u64,
     line: Vec<u8>,
     lookahead: Lookahead<Row>,
+    /// The rate was checked against the first records ([`SerialReader::probe_rate`]).
+    probed: bool,
+    period_us: f64,
+    recent: Recent,
+    /// The last kept line's raw time and values, for the plausibility of the next.
+    last_row: Option<(u32, i16, [i16; 3])>,
     pending_accel: Option<AccelSample>,
     clock: Clock,
     counter: Counter,
@@ -66,6 +90,10 @@ impl<R: BufRead> SerialReader<R> {
             line_no: 0,
             line: Vec::with_capacity(128),
             lookahead: Lookahead::default(),
+            probed: false,
+            period_us: 5000.0,
+            recent: Recent::default(),
+            last_row: None,
             pending_accel: None,
             clock: Clock::default(),
             counter: Counter::default(),
@@ -77,13 +105,87 @@ impl<R: BufRead> SerialReader<R> {
         me.cpr = me.header.encoder_cpr();
         me.lsb_per_g = me.header.accel_lsb_per_g();
         me.gaps = GapTracker::new("serial", me.header.sample_hz(), opts.gap_factor);
-        let period_us = 1e6 / me.header.sample_hz();
-        me.order = OrderRule {
+        me.set_period(1e6 / me.header.sample_hz());
+        Ok(me)
+    }
+
+    fn set_period(&mut self, period_us: f64) {
+        self.period_us = period_us;
+        self.gaps.set_period_us(period_us);
+        self.stats.encoder_period_us = period_us.round() as u64;
+        self.order = OrderRule {
             min_step_us: 1,
             period_us: period_us.round() as i64,
-            max_lone_step_us: (opts.gap_factor.max(1.0) * period_us).round() as i64,
+            max_lone_step_us: (self.opts.gap_factor.max(1.0) * period_us).round() as i64,
         };
-        Ok(me)
+    }
+
+    /// Reads the first [`RATE_PROBE_RECORDS`] lines ahead and checks the header's `sample_hz`
+    /// against their median step ([`check_rate`]): when they disagree, the stamps win (a wrong
+    /// header rate used to make every step look like a jump and drop the whole run).
+    fn probe_rate(&mut self) -> Result<(), RigError> {
+        self.probed = true;
+        let mut ahead = std::mem::take(&mut self.lookahead);
+        let filled = ahead.fill_to(RATE_PROBE_RECORDS, || self.next_row());
+        self.lookahead = ahead;
+        filled?;
+        let t: Vec<u32> = self.lookahead.iter().map(|r| r.t_us).collect();
+        let steps = t.windows(2).map(|w| signed_step(w[0], w[1])).collect();
+        let rc = check_rate("sample_hz", self.header.sample_hz(), steps, "line");
+        if let Some(w) = rc.warning {
+            self.stats.warn(w);
+            self.set_period(rc.period_us);
+        }
+        Ok(())
+    }
+
+    /// Why a line whose time is accepted still cannot be believed: an encoder or accelerometer
+    /// value that moved further than the pendulum or the shaker can since the last kept line,
+    /// while the next lines side with that one ([`value_glitch`]). `fresh`: the line starts a
+    /// new segment (nothing to compare with).
+    fn implausible(&self, cand: &Row, fresh: bool) -> Option<String> {
+        let prev = if fresh { None } else { self.last_row };
+        let next: Vec<&Row> = self.lookahead.iter().take(CONFIRM_RECORDS).collect();
+        let cpr = self.cpr;
+        let enc_ok = |a: (u32, i16), b: (u32, i16)| {
+            encoder_step_plausible(i64::from(b.1.wrapping_sub(a.1)), signed_step(a.0, b.0), cpr)
+        };
+        let enc_next: Vec<(u32, i16)> = next.iter().map(|r| (r.t_us, r.enc)).collect();
+        if value_glitch(
+            prev.map(|p| (p.0, p.1)),
+            (cand.t_us, cand.enc),
+            &enc_next,
+            enc_ok,
+        ) {
+            let from = prev.map_or(String::new(), |p| {
+                format!(
+                    " ({} counts in {} µs)",
+                    i64::from(cand.enc.wrapping_sub(p.1)),
+                    signed_step(p.0, cand.t_us)
+                )
+            });
+            return Some(format!(
+                "encoder value {} moves faster than the pendulum can{from}: a glitch",
+                cand.enc
+            ));
+        }
+        let (lsb, g) = (self.lsb_per_g, self.opts.g_m_s2);
+        let acc_ok = |a: (u32, [i16; 3]), b: (u32, [i16; 3])| {
+            accel_step_plausible(a.1, b.1, signed_step(a.0, b.0), lsb, g)
+        };
+        let acc_next: Vec<(u32, [i16; 3])> = next.iter().map(|r| (r.t_us, r.accel)).collect();
+        if value_glitch(
+            prev.map(|p| (p.0, p.2)),
+            (cand.t_us, cand.accel),
+            &acc_next,
+            acc_ok,
+        ) {
+            return Some(format!(
+                "accelerometer values {:?} change faster than the shaker can: a glitch",
+                cand.accel
+            ));
+        }
+        None
     }
 
     pub fn header(&self) -> &Header {
@@ -225,40 +327,83 @@ impl<R: BufRead> SerialReader<R> {
         if let Some(a) = self.pending_accel.take() {
             return Ok(Some(Sample::Accel(a)));
         }
+        if !self.probed {
+            self.probe_rate()?;
+        }
         loop {
             // Taken out while it reads, so that the reader can borrow itself.
             let mut ahead = std::mem::take(&mut self.lookahead);
-            let filled = ahead.fill(|| self.next_row());
+            let mut filled = ahead.fill(|| self.next_row());
+            if filled.is_ok() && ahead.front_jumps(self.clock.last_raw(), self.order) {
+                filled = ahead.fill_to(TIMELINE_WINDOW, || self.next_row());
+            }
             self.lookahead = ahead;
             filled?;
             let Some((cand, verdict)) =
                 self.lookahead
-                    .pop_checked(|x| x.t_us, self.clock.last_raw(), self.order)
+                    .pop_judged(self.clock.last_raw(), self.order, &self.recent)
             else {
                 return Ok(None);
             };
-            let t_us = match (verdict, self.clock.peek(cand.t_us)) {
-                (Ok(()), Some(t)) => t,
-                (Err(why), _) => {
-                    let reason = format!("{why} (t_us={}): garbled", cand.t_us);
-                    self.stats
-                        .skip(Location::Line(cand.line), reason, cand.bytes);
-                    continue;
-                }
-                (Ok(()), None) => {
-                    self.stats.skip(
-                        Location::Line(cand.line),
-                        "time before the capture start",
-                        cand.bytes,
-                    );
+            let at = Location::Line(cand.line);
+            let segment = match verdict {
+                Timeline::Keep => None,
+                Timeline::NewSegment { reset } => Some(reset),
+                Timeline::Drop {
+                    reason,
+                    off_timeline,
+                    duplicate,
+                } => {
+                    let reason = if off_timeline {
+                        self.stats.off_timeline += 1;
+                        self.stats.duplicates += u64::from(duplicate);
+                        if !duplicate {
+                            self.recent.push_dropped(&cand);
+                        }
+                        format!("{reason}: dropped")
+                    } else {
+                        format!("{reason} (t_us={}): garbled", cand.t_us)
+                    };
+                    self.stats.skip(at, reason, cand.bytes);
                     continue;
                 }
             };
-            self.clock.commit(cand.t_us, t_us, &mut self.stats);
+            let t_us = match segment {
+                Some(reset) => {
+                    self.clock
+                        .reanchor_t(cand.t_us, reset, self.period_us.round() as u64)
+                }
+                None => match self.clock.peek(cand.t_us) {
+                    Some(t) => t,
+                    None => {
+                        self.stats
+                            .skip(at, "time before the capture start", cand.bytes);
+                        continue;
+                    }
+                },
+            };
+            if let Some(why) = self.implausible(&cand, segment.is_some()) {
+                self.stats.implausible += 1;
+                self.stats.skip(at, format!("{why}: dropped"), cand.bytes);
+                continue;
+            }
+            match segment {
+                Some(reset) => {
+                    self.clock.reanchor(cand.t_us, t_us);
+                    self.start_segment(at, cand.t_us, t_us, reset);
+                }
+                None => self.clock.commit(cand.t_us, t_us, &mut self.stats),
+            }
             self.gaps.step(t_us, &mut self.stats);
             let count = self.counter.step(cand.enc, &mut self.stats);
-            self.stats.encoder_samples += 1;
+            self.stats.kept_encoder(t_us);
             self.stats.accel_samples += 1;
+            self.stats.kept_bytes += cand.bytes;
+            if self.recent.push_kept(&cand) {
+                // A copy seen before its original (dropped off the timeline) was a duplicate.
+                self.stats.duplicates += 1;
+            }
+            self.last_row = Some((cand.t_us, cand.enc, cand.accel));
             self.pending_accel = Some(AccelSample {
                 t_us_raw: cand.t_us,
                 t_us,
@@ -272,6 +417,22 @@ impl<R: BufRead> SerialReader<R> {
                 count,
                 theta_rad: theta_rad(count, self.cpr),
             })));
+        }
+    }
+
+    /// Bookkeeping of a new segment (see [`Timeline::NewSegment`]).
+    fn start_segment(&mut self, at: Location, raw: u32, t_us: u64, reset: bool) {
+        self.stats.new_segments += 1;
+        self.recent.clear();
+        if reset {
+            self.counter.restart();
+            self.stats.warn(format!(
+                "{at}: the board clock restarted (t_us={raw}; a board reset): new segment from unwrapped t_us {t_us}; the encoder count restarts at the board's power-on zero"
+            ));
+        } else {
+            self.stats.warn(format!(
+                "{at}: the clock moved back for good (t_us={raw}): new segment from unwrapped t_us {t_us}"
+            ));
         }
     }
 }
