@@ -142,6 +142,63 @@ fn free_decay_fit_recovers_omega0_and_damping() {
     assert!((m - M_BEARING).abs() < 0.02 * M_BEARING, "M {m}");
     assert!((off - OFFSET).abs() < 2e-4, "offset {off}");
     assert!(fit.runs[0].steady_agrees(), "{:?}", fit.runs[0]);
+
+    // Issue 16 item 4: nothing of this fit sits at a bound; an encoder offset pinned at its
+    // ±0.05 rad limit is reported as such.
+    let window = Window {
+        window_s: 10.0,
+        sample_hz: 100.0,
+        segment_s: Some(0.5),
+        t_sim_s: None,
+    };
+    let prepared =
+        crate::identify::prepare_run(&run, &al, &ic, &steady, &steady_cfg, &window).unwrap();
+    let runs = std::slice::from_ref(&prepared);
+    let none = crate::identify::params_at_bounds(runs, &fit);
+    assert!(none.is_empty(), "{none:?}");
+    let mut pinned = fit.clone();
+    let k = pinned
+        .spec
+        .params
+        .iter()
+        .position(|p| *p == FitParam::EncoderOffset)
+        .expect("offset fitted");
+    pinned.params[k] = 0.05;
+    let notes = crate::identify::params_at_bounds(runs, &pinned);
+    eprintln!("{notes:?}");
+    assert!(
+        notes.len() == 1
+            && notes[0].contains("encoder_offset")
+            && notes[0].contains("upper bound 0.05"),
+        "{notes:?}"
+    );
+}
+
+/// Issue 16 item 4: a free decay that comes to rest inside the classified tail is `rest`, not
+/// `oscillation (period 1)`; one still swinging at the end of the capture stays `oscillation`.
+#[test]
+fn regression_issue_16_free_decay_ending_at_rest_is_rest() {
+    use crate::measured::classify_free;
+    // 10 s of tail: swinging (decaying) for the first 3 s, then still on one count.
+    let q = std::f64::consts::TAU / 4096.0;
+    let tail: Vec<f64> = (0..1000)
+        .map(|i| {
+            let t = i as f64 * 0.01;
+            let v = if t < 3.0 {
+                0.05 * (1.0 - t / 3.0) * (7.0 * t).cos()
+            } else {
+                0.0
+            };
+            (v / q).floor() * q
+        })
+        .collect();
+    let s = classify_free(&tail, 0.01);
+    assert_eq!(s.class, SteadyClass::Rest, "{s}");
+    assert_eq!(s.to_string(), "rest");
+    let swinging: Vec<f64> = (0..1000)
+        .map(|i| 0.05 * (7.0 * i as f64 * 0.01).cos())
+        .collect();
+    assert_eq!(classify_free(&swinging, 0.01).class, SteadyClass::Oscillation);
 }
 
 /// The free-decay fit's constant dry torque term (`coulomb_constant` → c per m g l): a decay with

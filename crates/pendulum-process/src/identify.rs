@@ -432,6 +432,54 @@ pub fn identify(
     })
 }
 
+/// The fitted parameters that sit at a search bound (within 0.1 % of the bounds' span), in
+/// words: an estimate pinned there is the bound's, not the data's (an encoder offset at its
+/// ±0.05 rad limit, ω0 at ±5 % of the swings' estimate). A damping term at its lower bound 0 is
+/// said too: the fit does not use it, which is a finding, not a measured zero.
+pub fn params_at_bounds(runs: &[PreparedRun], out: &FitOutcome) -> Vec<String> {
+    let objective = StudyObjective {
+        runs,
+        spec: &out.spec,
+        kappa: 1.0,
+        sim: SimOptions::default(),
+        ic_halfwidth: 0.0,
+        fixed_params: None,
+        penalty: false,
+        order: Default::default(),
+    };
+    let bounds = objective.bounds_vec();
+    let mut notes = Vec::new();
+    for ((p, &v), &(lo, hi)) in out.spec.params.iter().zip(&out.params).zip(&bounds) {
+        let tol = 1e-3 * (hi - lo);
+        let at = if v <= lo + tol {
+            Some(("lower", lo))
+        } else if v >= hi - tol {
+            Some(("upper", hi))
+        } else {
+            None
+        };
+        let Some((side, b)) = at else {
+            continue;
+        };
+        let what = if side == "lower" && b == 0.0 {
+            "the fit does not use it (the estimate is the bound, not a measured 0)".to_string()
+        } else {
+            format!(
+                "the estimate is the bound's, not the data's: the search range [{lo:.4}, {hi:.4}] {} \
+                 cut the fit short (or the model lacks what the fit tries to absorb with it)",
+                p.unit()
+            )
+        };
+        notes.push(format!(
+            "fit {}: {} = {v:.4e} {} sits at its {side} bound {b:.4}: {what}",
+            out.spec.name,
+            p.name(),
+            p.unit()
+        ));
+    }
+    notes
+}
+
 /// The model to fit or validate on `runs`: a free-decay campaign gets the spec's identifiable
 /// counterpart ([`ModelSpec::free_decay`]); free decays and shaker runs cannot share one fit.
 pub fn spec_for_runs(
