@@ -606,8 +606,7 @@ fn median(v: &mut [f64]) -> f64 {
 }
 
 /// The angle's step q and where it comes from: `stated` (2π / counts per revolution) when the
-/// capture gives it, else the smallest non-zero step seen (its 2nd percentile, so one odd tiny
-/// step, e.g. a value printed with one digit less, does not set it).
+/// capture gives it, else the smallest non-zero step seen.
 fn angle_step(th: &[f64], stated: Option<f64>) -> (f64, String) {
     let mut steps: Vec<f64> = th
         .windows(2)
@@ -615,7 +614,12 @@ fn angle_step(th: &[f64], stated: Option<f64>) -> (f64, String) {
         .filter(|d| *d > 0.0)
         .collect();
     steps.sort_by(f64::total_cmp);
-    let seen = steps.get(steps.len() / 50).copied().unwrap_or(0.0);
+    // The smallest step seen at least 3 times (within 2 %, for values printed with few
+    // digits): one odd tiny step does not set it, and a fast swing, whose steps are mostly
+    // several counts, still shows its single counts near the turning points.
+    let seen = (0..steps.len())
+        .find(|&i| steps.partition_point(|&x| x <= 1.02 * steps[i]) - i >= 3)
+        .map_or(0.0, |i| steps[i]);
     match stated {
         Some(q) if q > 0.0 && q.is_finite() => {
             let mut source = format!(
@@ -2248,9 +2252,14 @@ fn unexplained(
         let mut diffs: Vec<f64> = swings.windows(2).map(|p| (p[1].1 - p[0].1).abs()).collect();
         let sigma = 1.4826 * median(&mut diffs) / std::f64::consts::SQRT_2;
         let thr = (5.0 * sigma).max(0.01);
+        // On a staircase of step q a turning point can sit anywhere on the plateau where the
+        // swing stays within one step of its extreme, sqrt(2q/A)/omega_n either side: that
+        // much of the half period (π/omega_n) is the encoder's, not the restoring torque's.
+        let q = env.resolution.step_rad;
+        let allowance = |a: f64| (2.0 * q / a.max(1e-300)).sqrt() / std::f64::consts::PI;
         let off: Vec<&(f64, f64, f64)> = swings
             .iter()
-            .filter(|s| (s.1 - r_ref).abs() > thr)
+            .filter(|s| (s.1 - r_ref).abs() > thr.max(allowance(s.0)))
             .collect();
         if off.len() >= 2 {
             let lo = off.iter().map(|s| s.0).fold(f64::INFINITY, f64::min);
