@@ -600,9 +600,7 @@ fn free_decay_campaign(dir: &Path, seed: u64, b: f64, mu: f64) -> Vec<f64> {
         betas.push(phys.to_dimensionless().beta);
         eprintln!(
             "free decay d{k}: m {} kg, l {:.4} m, θ0 {theta0:.3} rad, {duration_s:.1} s, β {:.4e}",
-            phys.m_kg,
-            phys.l_m,
-            betas[k]
+            phys.m_kg, phys.l_m, betas[k]
         );
     }
     std::fs::write(dir.join("campaign.toml"), toml).unwrap();
@@ -675,7 +673,9 @@ fn regression_issue_16_quantised_decay_stops_at_three_counts() {
         "name = \"quantised\"\n[rig]\nformat = \"timeseries\"\ntime_column = \"t_s\"\nangle_column = \"angle\"\nhanging_angle = 0\nr_b_m = 0.01225\nrole = \"identify\"\n",
     );
     let cprs = [1024u32, 4096];
-    toml.push_str(&quantised_decay_run(&camp, 1601, "coarse", cprs[0], "counts"));
+    toml.push_str(&quantised_decay_run(
+        &camp, 1601, "coarse", cprs[0], "counts",
+    ));
     toml.push_str(&quantised_decay_run(&camp, 1602, "degrees", cprs[1], "deg"));
     std::fs::write(camp.join("campaign.toml"), toml).unwrap();
     let s = run(&DiscoverJob {
@@ -710,7 +710,11 @@ fn regression_issue_16_quantised_decay_stops_at_three_counts() {
         let th: Vec<f64> = d.envelope.rows.iter().map(|r| r.theta_rad).collect();
         for w in th.windows(2) {
             let swing = 0.5 * (w[1] - w[0]).abs();
-            assert!(swing >= 3.0 * q, "run {id}: a swing of {:.2} counts", swing / q);
+            assert!(
+                swing >= 3.0 * q,
+                "run {id}: a swing of {:.2} counts",
+                swing / q
+            );
         }
         // A gravity pendulum: a period drift at the few-count swings would be the staircase's
         // timing, not a restoring torque (it was +19.5 % at 3–20 counts before the allowance).

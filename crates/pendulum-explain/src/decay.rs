@@ -2682,10 +2682,17 @@ mod tests {
                 "{stated:?}: step {} vs {q}",
                 res.step_rad
             );
-            assert!(res.ended_at_s.is_some() && res.dropped_turning_points > 0, "{res:?}");
+            assert!(
+                res.ended_at_s.is_some() && res.dropped_turning_points > 0,
+                "{res:?}"
+            );
             for w in tps.windows(2) {
                 let swing = 0.5 * (w[1].theta_rad - w[0].theta_rad).abs();
-                assert!(swing >= MIN_SWING_STEPS * res.step_rad, "{swing} at {}", w[0].t_s);
+                assert!(
+                    swing >= MIN_SWING_STEPS * res.step_rad,
+                    "{swing} at {}",
+                    w[0].t_s
+                );
             }
             let d = diagnose_decay(
                 &t,

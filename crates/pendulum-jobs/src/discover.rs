@@ -729,11 +729,7 @@ fn write_decay_tables(
                 col(&|d| d.t_split_s),
             ),
             Column::f64("noise_rad", "rad", col(&|d| d.envelope.noise_rad)),
-            Column::f64(
-                "e_theta_heldout_base",
-                "rad",
-                col(&|d| score(d, "base")),
-            ),
+            Column::f64("e_theta_heldout_base", "rad", col(&|d| score(d, "base"))),
             Column::f64(
                 "e_theta_heldout_best",
                 "rad (NaN: nothing added)",

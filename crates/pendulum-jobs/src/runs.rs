@@ -279,7 +279,6 @@ pub fn angle_step_rad(format: Option<&str>, header: &[(String, String)]) -> Opti
     }
     let timeseries = format == Some(pendulum_rig::timeseries::FORMAT)
         || get("format").map(String::as_str) == Some(pendulum_rig::timeseries::FORMAT);
-    (!timeseries).then(|| {
-        std::f64::consts::TAU / f64::from(pendulum_rig::capture::DEFAULT_ENCODER_CPR)
-    })
+    (!timeseries)
+        .then(|| std::f64::consts::TAU / f64::from(pendulum_rig::capture::DEFAULT_ENCODER_CPR))
 }

@@ -142,9 +142,19 @@ fn free_decay_fit_recovers_omega0_and_damping() {
     assert!((m - M_BEARING).abs() < 0.02 * M_BEARING, "M {m}");
     assert!((off - OFFSET).abs() < 2e-4, "offset {off}");
     assert!(fit.runs[0].steady_agrees(), "{:?}", fit.runs[0]);
+}
 
-    // Issue 16 item 4: nothing of this fit sits at a bound; an encoder offset pinned at its
-    // ±0.05 rad limit is reported as such.
+/// Issue 16 item 4: parameters at their search bounds are reported as such. Nothing of the
+/// linear + bearing fit sits at a bound; the same fit with its encoder offset pinned at the
+/// ±0.05 rad limit gets a note naming it.
+#[test]
+fn regression_issue_16_params_at_bounds_are_reported() {
+    let run = synthetic_decay();
+    let al = align(&run, &AlignConfig::default()).expect("free-decay alignment");
+    let ic = estimate_state(&run, al.t0_s, &IcConfig::default()).expect("initial state");
+    let steady_cfg = SteadyConfig::default();
+    let steady = free_steady_state(&run, al.t0_s, &steady_cfg).expect("steady");
+    let fit = fit_linear_plus(&run, &al, &ic, &steady, FitParam::Mu);
     let window = Window {
         window_s: 10.0,
         sample_hz: 100.0,
@@ -198,7 +208,10 @@ fn regression_issue_16_free_decay_ending_at_rest_is_rest() {
     let swinging: Vec<f64> = (0..1000)
         .map(|i| 0.05 * (7.0 * i as f64 * 0.01).cos())
         .collect();
-    assert_eq!(classify_free(&swinging, 0.01).class, SteadyClass::Oscillation);
+    assert_eq!(
+        classify_free(&swinging, 0.01).class,
+        SteadyClass::Oscillation
+    );
 }
 
 /// The free-decay fit's constant dry torque term (`coulomb_constant` → c per m g l): a decay with

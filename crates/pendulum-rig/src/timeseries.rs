@@ -693,7 +693,11 @@ impl<R: BufRead> TimeseriesReader<R> {
         // A given rate anchors on the first rows only: over the file it may drift off the
         // stamps, which is what the user asked for.
         let given = self.spec.sample_hz.is_some();
-        let anchor = if given { &rows[..rows.len().min(256)] } else { &rows[..] };
+        let anchor = if given {
+            &rows[..rows.len().min(256)]
+        } else {
+            &rows[..]
+        };
         self.bursts = Some(BurstClock::new(anchor, rate_hz, interval_s, !given));
         Ok(())
     }
@@ -1298,7 +1302,6 @@ mod tests {
         assert!(e.contains("n.csv") && e.contains("column-name"), "{e}");
     }
 
-
     /// A host that reads the serial buffer every ~62 ms and stamps every row it got with the
     /// time of the read: `rows` samples at `rate_hz`, stamps in ms.
     fn bursty_csv(rate_hz: f64, rows: usize, jitter_ms: f64) -> String {
@@ -1311,7 +1314,10 @@ mod tests {
             while i < rows && (i as f64) * 1e3 / rate_hz <= read_at {
                 let t = i as f64 / rate_hz;
                 let deg = 20.0 * (-0.05 * t).exp() * (9.0 * t).cos();
-                text.push_str(&format!("{read_at:.0},{:.3}\n", (deg / 0.088).round() * 0.088));
+                text.push_str(&format!(
+                    "{read_at:.0},{:.3}\n",
+                    (deg / 0.088).round() * 0.088
+                ));
                 i += 1;
             }
             k += 1;
@@ -1335,10 +1341,16 @@ mod tests {
         assert_eq!(st.skipped_lines_or_frames, 0, "{:?}", st.skips);
         assert_eq!(st.gap_count, 0, "{:?}", st.gaps);
         let measured: f64 = h.get("sample_hz_measured").unwrap().parse().unwrap();
-        assert!((measured / rate - 1.0).abs() < 0.01, "measured {measured} Hz");
+        assert!(
+            (measured / rate - 1.0).abs() < 0.01,
+            "measured {measured} Hz"
+        );
         let span_s = (e[e.len() - 1].t_us - e[0].t_us) as f64 * 1e-6;
         let recovered = (e.len() - 1) as f64 / span_s;
-        assert!((recovered / rate - 1.0).abs() < 0.01, "rows say {recovered} Hz");
+        assert!(
+            (recovered / rate - 1.0).abs() < 0.01,
+            "rows say {recovered} Hz"
+        );
         assert!(e.windows(2).all(|w| w[1].t_us > w[0].t_us));
         let tb = h.get("time_base").unwrap();
         assert!(tb.contains("bursts") && tb.contains("Hz"), "{tb}");
@@ -1369,7 +1381,9 @@ mod tests {
     /// resolution), a value on the grid giving its own count.
     #[test]
     fn regression_issue_16_counts_per_rev_with_degrees() {
-        let s = spec("sample_hz = 100\nangle_column = \"a\"\nangle_unit = \"deg\"\ncounts_per_rev = 4096");
+        let s = spec(
+            "sample_hz = 100\nangle_column = \"a\"\nangle_unit = \"deg\"\ncounts_per_rev = 4096",
+        );
         let step = 360.0 / 4096.0;
         let text = format!("a\n0\n{}\n{}\n", 3.0 * step, -5.0 * step);
         let (v, _, h) = read_all(&text, s);
