@@ -184,6 +184,48 @@ fn regression_issue_16_params_at_bounds_are_reported() {
     );
 }
 
+/// Issue 16 item 4: free decays whose swings give different ω0 (here 7.0 and 7.0/1.3 rad/s:
+/// the second run's clock stretched) get a note when one ω0 is forced on both; one run alone,
+/// or two runs of one pendulum, get none.
+#[test]
+fn regression_issue_16_shared_omega0_is_warned() {
+    let window = Window {
+        window_s: 10.0,
+        sample_hz: 100.0,
+        segment_s: Some(0.5),
+        t_sim_s: None,
+    };
+    let steady_cfg = SteadyConfig::default();
+    let prepare = |run: &RunData| {
+        let al = align(run, &AlignConfig::default()).expect("alignment");
+        let ic = estimate_state(run, al.t0_s, &IcConfig::default()).expect("initial state");
+        let steady = free_steady_state(run, al.t0_s, &steady_cfg).expect("steady");
+        let p = crate::identify::prepare_run(run, &al, &ic, &steady, &steady_cfg, &window)
+            .expect("prepare");
+        (p, al, ic, steady)
+    };
+    let a = synthetic_decay();
+    let mut b = synthetic_decay();
+    b.id = "slow".into();
+    for t in &mut b.enc_t_s {
+        *t *= 1.3;
+    }
+    let mut a2 = synthetic_decay();
+    a2.id = "again".into();
+    let (pa, al, ic, steady) = prepare(&a);
+    let fit = fit_linear_plus(&a, &al, &ic, &steady, FitParam::Mu);
+    let (pb, ..) = prepare(&b);
+    let (pa2, ..) = prepare(&a2);
+    let notes = crate::identify::shared_omega0_notes(&[pa.clone(), pb], &fit);
+    eprintln!("{notes:?}");
+    assert!(
+        notes.len() == 1 && notes[0].contains("free 7.0") && notes[0].contains("slow 5.3"),
+        "{notes:?}"
+    );
+    assert!(crate::identify::shared_omega0_notes(std::slice::from_ref(&pa), &fit).is_empty());
+    assert!(crate::identify::shared_omega0_notes(&[pa, pa2], &fit).is_empty());
+}
+
 /// Issue 16 item 4: a free decay that comes to rest inside the classified tail is `rest`, not
 /// `oscillation (period 1)`; one still swinging at the end of the capture stays `oscillation`.
 #[test]

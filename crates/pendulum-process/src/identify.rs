@@ -480,6 +480,34 @@ pub fn params_at_bounds(runs: &[PreparedRun], out: &FitOutcome) -> Vec<String> {
     notes
 }
 
+/// Free decays share one ω0 in a fit. When the runs' own ω0 (from their swing periods, good to
+/// about 0.1 %) differ by more than 1 %, that shared value fits none of them: say so, with each
+/// run's ω0 (two recordings of 29.7 and 17.3 rad/s were fitted with 22.4 in silence).
+pub fn shared_omega0_notes(runs: &[PreparedRun], out: &FitOutcome) -> Vec<String> {
+    if runs.len() < 2 || !out.spec.params.contains(&FitParam::Omega0) {
+        return Vec::new();
+    }
+    let w: Vec<f64> = runs.iter().map(|r| r.omega0_rad_s).collect();
+    let (lo, hi) = w.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |a, &v| {
+        (a.0.min(v), a.1.max(v))
+    });
+    if !(hi / lo - 1.0 > 0.01) {
+        return Vec::new();
+    }
+    let each: Vec<String> = runs
+        .iter()
+        .map(|r| format!("{} {:.3} rad/s", r.id, r.omega0_rad_s))
+        .collect();
+    vec![format!(
+        "fit {}: one omega0 ({:.3} rad/s) is forced on runs whose swings say {} ({:+.1} % apart): \
+         they are not one pendulum (or not one set-up); fit them separately",
+        out.spec.name,
+        out.param(FitParam::Omega0),
+        each.join(", "),
+        100.0 * (hi / lo - 1.0)
+    )]
+}
+
 /// The model to fit or validate on `runs`: a free-decay campaign gets the spec's identifiable
 /// counterpart ([`ModelSpec::free_decay`]); free decays and shaker runs cannot share one fit.
 pub fn spec_for_runs(

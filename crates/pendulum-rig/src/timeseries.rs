@@ -394,7 +394,7 @@ struct BurstClock {
 /// What the probe found about bursty stamps.
 #[derive(Debug, Clone, PartialEq)]
 struct BurstStats {
-    /// Rate = rows / elapsed time over the complete bursts, Hz.
+    /// Rate = rows / elapsed time over the complete bursts (lost reads left out), Hz.
     rate_hz: f64,
     /// Median over bursts of (rows in the burst / time since the previous stamp), Hz.
     median_rate_hz: f64,
@@ -407,7 +407,8 @@ struct BurstStats {
 /// Bursts of equal stamps among `rows` (file order): the measured rate, or why there is none.
 /// Rows of burst k were sampled after stamp k−1 and up to stamp k, so the rate counts the rows
 /// of bursts 2..K over the time from stamp 1 to stamp K (the first burst may be partial and the
-/// last one cut by the probe).
+/// last one cut by the probe), leaving out bursts after a read period longer than 1.5 times the
+/// median (lost reads).
 fn burst_stats(rows: &[Row]) -> Result<BurstStats, String> {
     // (stamp, index of the burst's first row)
     let mut starts: Vec<(f64, u64)> = Vec::new();
@@ -428,23 +429,38 @@ fn burst_stats(rows: &[Row]) -> Result<BurstStats, String> {
         ));
     }
     let k = starts.len() - 1; // starts[k] closes burst k−1 (0-based bursts 1..k−1 complete)
-    let rows_counted = (starts[k].1 - starts[1].1) as f64;
-    let elapsed = starts[k - 1].0 - starts[0].0;
+                              // (rows, time since the previous stamp) of each complete burst
+    let bursts: Vec<(f64, f64)> = (1..k)
+        .map(|j| {
+            (
+                (starts[j + 1].1 - starts[j].1) as f64,
+                starts[j].0 - starts[j - 1].0,
+            )
+        })
+        .collect();
+    let mut iv: Vec<f64> = bursts.iter().map(|b| b.1).collect();
+    iv.sort_by(f64::total_cmp);
+    let interval_s = iv[iv.len() / 2];
+    // Reads whose rows were lost leave a long interval before the next stamp with an ordinary
+    // burst: rows / time over them would make the rate too low, so they are left out.
+    let kept: Vec<&(f64, f64)> = bursts.iter().filter(|b| b.1 <= 1.5 * interval_s).collect();
+    let rows_counted: f64 = kept.iter().map(|b| b.0).sum();
+    let elapsed: f64 = kept.iter().map(|b| b.1).sum();
     if !(elapsed > 0.0 && rows_counted > 0.0) {
         return Err("the stamps do not advance".into());
     }
-    let mut per: Vec<f64> = (1..k)
-        .map(|j| (starts[j + 1].1 - starts[j].1) as f64 / (starts[j].0 - starts[j - 1].0))
+    let mut per: Vec<f64> = bursts
+        .iter()
+        .filter(|b| b.1 > 0.0)
+        .map(|b| b.0 / b.1)
         .collect();
     per.sort_by(f64::total_cmp);
-    let mut iv: Vec<f64> = starts.windows(2).map(|w| w[1].0 - w[0].0).collect();
-    iv.sort_by(f64::total_cmp);
     Ok(BurstStats {
         rate_hz: rows_counted / elapsed,
         median_rate_hz: per[per.len() / 2],
-        bursts: k - 1,
-        rows_per_stamp: rows_counted / (k - 1) as f64,
-        interval_s: iv[iv.len() / 2],
+        bursts: kept.len(),
+        rows_per_stamp: rows_counted / kept.len() as f64,
+        interval_s,
     })
 }
 
@@ -485,7 +501,7 @@ impl BurstClock {
         }
         let mut t = self.t0_s + r.index as f64 / self.rate_hz;
         let lead = r.t_s - t;
-        if self.reanchor && lead > self.gap_s {
+        if self.reanchor && lead - self.lag_s > self.gap_s {
             if !confirmed {
                 return Err(format!(
                     "time stamp jumps ahead ({} s, the rows' clock says {} s) and the next \
@@ -690,14 +706,14 @@ impl<R: BufRead> TimeseriesReader<R> {
             self.header
                 .set("sample_hz_measured", format!("{}", round_sig(b.rate_hz)));
         }
-        // A given rate anchors on the first rows only: over the file it may drift off the
-        // stamps, which is what the user asked for.
+        // The anchor: the rows before the first lost read (a stamp interval over 1.5 times the
+        // usual), at most 2,000: later rows would pull the typical wait up by the gap.
         let given = self.spec.sample_hz.is_some();
-        let anchor = if given {
-            &rows[..rows.len().min(256)]
-        } else {
-            &rows[..]
-        };
+        let first_gap = rows
+            .windows(2)
+            .position(|w| interval_s > 0.0 && w[1].t_s - w[0].t_s > 1.5 * interval_s)
+            .map_or(rows.len(), |i| i + 1);
+        let anchor = &rows[..first_gap.clamp(1, 2000)];
         self.bursts = Some(BurstClock::new(anchor, rate_hz, interval_s, !given));
         Ok(())
     }
@@ -1303,9 +1319,16 @@ mod tests {
     }
 
     /// A host that reads the serial buffer every ~62 ms and stamps every row it got with the
-    /// time of the read: `rows` samples at `rate_hz`, stamps in ms.
-    fn bursty_csv(rate_hz: f64, rows: usize, jitter_ms: f64) -> String {
+    /// time of the read: `rows` samples at `rate_hz`, stamps in ms; the reads numbered in `lost`
+    /// lose their rows. Returns the text and each written row's true time, s.
+    fn bursty_csv(
+        rate_hz: f64,
+        rows: usize,
+        jitter_ms: f64,
+        lost: std::ops::Range<usize>,
+    ) -> (String, Vec<f64>) {
         let mut text = String::from("# host=laptop\nt_ms,angle_deg\n");
+        let mut truth = Vec::new();
         let mut read_at = 62.0;
         let mut k = 0usize;
         let mut i = 0usize;
@@ -1314,10 +1337,13 @@ mod tests {
             while i < rows && (i as f64) * 1e3 / rate_hz <= read_at {
                 let t = i as f64 / rate_hz;
                 let deg = 20.0 * (-0.05 * t).exp() * (9.0 * t).cos();
-                text.push_str(&format!(
-                    "{read_at:.0},{:.3}\n",
-                    (deg / 0.088).round() * 0.088
-                ));
+                if !lost.contains(&k) {
+                    text.push_str(&format!(
+                        "{read_at:.0},{:.3}\n",
+                        (deg / 0.088).round() * 0.088
+                    ));
+                    truth.push(t);
+                }
                 i += 1;
             }
             k += 1;
@@ -1325,7 +1351,7 @@ mod tests {
             let u = ((k * 7919) % 101) as f64 / 100.0 - 0.5;
             read_at += 62.0 + 2.0 * jitter_ms * u;
         }
-        text
+        (text, truth)
     }
 
     /// Issue 16 item 3: bursty stamps (15–16 rows share one, no sample lost) keep every row,
@@ -1333,7 +1359,7 @@ mod tests {
     #[test]
     fn regression_issue_16_bursty_stamps_keep_every_row() {
         let rate = 259.3;
-        let text = bursty_csv(rate, 7625, 4.0);
+        let (text, _) = bursty_csv(rate, 7625, 4.0, 0..0);
         let s = spec("time_column = \"t_ms\"\ntime_unit = \"ms\"\nangle_column = \"angle_deg\"\nangle_unit = \"deg\"");
         let (v, st, h) = read_all(&text, s);
         let e = enc(&v);
@@ -1363,6 +1389,22 @@ mod tests {
         assert_eq!(e.len(), 7625);
         assert_eq!(e[250].t_us - e[0].t_us, 1_000_000);
         assert!(h.get("time_base").unwrap().contains("sample_hz = 250"));
+
+        // Reads 300–304 lost (after the probe would be the same): a gap, the clock re-anchored
+        // on the stamps, every later row within one read period of its true time.
+        let (lossy, truth) = bursty_csv(rate, 30_000, 4.0, 300..305);
+        let s = spec("time_column = \"t_ms\"\ntime_unit = \"ms\"\nangle_column = \"angle_deg\"\nangle_unit = \"deg\"");
+        let (v, st, h) = read_all(&lossy, s);
+        eprintln!("lossy: {:?}", h.get("time_base"));
+        let e = enc(&v);
+        assert_eq!(e.len(), truth.len(), "{:?}", st.skips);
+        assert_eq!(st.gap_count, 1, "{:?}", st.gaps);
+        let worst = e
+            .iter()
+            .zip(&truth)
+            .map(|(x, t)| ((x.t_us - e[0].t_us) as f64 * 1e-6 - (t - truth[0])).abs())
+            .fold(0.0, f64::max);
+        assert!(worst < 0.062, "a row {worst} s off its time");
 
         // Too few bursts to measure a rate and no sample_hz: refused, naming the problem.
         let short: String = text.lines().take(40).map(|l| format!("{l}\n")).collect();
