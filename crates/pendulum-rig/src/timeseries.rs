@@ -368,8 +368,9 @@ pub struct TimeseriesReader<R: BufRead> {
     gaps: GapTracker,
     pending_accel: Option<AccelSample>,
     stats: IngestStats,
-    /// Bursty stamps: times come from the steady rate instead (see [`BurstClock`]).
-    bursts: Option<BurstClock>,
+    /// Bursty stamps: times come from the steady rate instead (see [`BurstClock`]). Boxed: the
+    /// reader is one variant of `CaptureReader`, whose variants should stay alike in size.
+    bursts: Option<Box<BurstClock>>,
 }
 
 /// The time base of a file whose stamps come in bursts (a host that reads the serial buffer
@@ -714,7 +715,9 @@ impl<R: BufRead> TimeseriesReader<R> {
             .position(|w| interval_s > 0.0 && w[1].t_s - w[0].t_s > 1.5 * interval_s)
             .map_or(rows.len(), |i| i + 1);
         let anchor = &rows[..first_gap.clamp(1, 2000)];
-        self.bursts = Some(BurstClock::new(anchor, rate_hz, interval_s, !given));
+        self.bursts = Some(Box::new(BurstClock::new(
+            anchor, rate_hz, interval_s, !given,
+        )));
         Ok(())
     }
 
