@@ -624,6 +624,139 @@ fn free_decay_campaign(dir: &Path, seed: u64, b: f64, mu: f64) -> Vec<f64> {
     betas
 }
 
+/// A free decay from the model's simulator that runs on to rest, its angle written as a coarse
+/// encoder would: `"counts"` (floor(θ·cpr/2π)) or `"deg"` printed to 0.01° (a 12-bit absolute
+/// encoder logged in degrees: steps of 0.08° and 0.09°, not multiples of one quantum), with
+/// `counts_per_rev = cpr` in either case. Little dry friction, so the last swings shrink through
+/// the few-count range instead of stopping at once.
+fn quantised_decay_run(dir: &Path, seed: u64, id: &str, cpr: u32, unit: &str) -> String {
+    use pendulum_model::{Model, Physical, SimOptions};
+    let mut r = rng(seed);
+    let phys = Physical {
+        m_kg: 1.46,
+        l_m: r.random_range(0.18..0.26),
+        crank_r_m: 0.0,
+        r_b_m: 0.01225,
+        a_kg_m: 0.0,
+        b_n_s_m: 0.45,
+        mu: 0.005,
+        ..Physical::default()
+    };
+    let w0 = phys.omega0_rad_s();
+    let theta0: f64 = r.random_range(0.8..1.5);
+    let duration_s = 50.0;
+    let model = Model::new(phys.to_dimensionless());
+    let tr = pendulum_model::sim::simulate(
+        &model,
+        &SimOptions::default(),
+        [theta0, 0.0],
+        0.0,
+        duration_s * w0,
+        w0 / 200.0,
+    )
+    .unwrap();
+    let mut csv = String::from("t_s,angle\n");
+    for (tau, th) in tr.t.iter().zip(&tr.theta) {
+        let count = (th * f64::from(cpr) / std::f64::consts::TAU).floor();
+        let value = match unit {
+            "counts" => format!("{count}"),
+            _ => format!("{:.2}", count * 360.0 / f64::from(cpr)),
+        };
+        csv.push_str(&format!("{:.6},{value}\n", tau / w0));
+    }
+    let file = format!("{id}.csv");
+    std::fs::write(dir.join(&file), csv).unwrap();
+    eprintln!(
+        "quantised decay {id}: l {:.4} m, θ0 {theta0:.3} rad, {cpr} counts/rev as {unit}",
+        phys.l_m
+    );
+    format!(
+        "[[run]]\nid = \"{id}\"\nfile = \"{file}\"\nm_kg = {}\nl_m = {:.4}\nangle_unit = \"{unit}\"\ncounts_per_rev = {cpr}\n",
+        phys.m_kg, phys.l_m
+    )
+}
+
+/// Issue 16 item 2: a twin free decay quantised to a coarse encoder that runs on to rest. The
+/// analysis takes the resolution from `counts_per_rev` (also with degrees: item 4), stops where
+/// the swings fall below 3 counts (no turning point of a smaller swing is analysed), keeps the
+/// noise floor at the quantiser's q/√12 (never 1e-12 on a record mostly at rest), and the
+/// report says where the resolution ended the analysis.
+#[test]
+fn regression_issue_16_quantised_decay_stops_at_three_counts() {
+    let dir = tempfile::tempdir().unwrap();
+    let camp = dir.path().join("campaign");
+    std::fs::create_dir_all(&camp).unwrap();
+    let mut toml = String::from(
+        "name = \"quantised\"\n[rig]\nformat = \"timeseries\"\ntime_column = \"t_s\"\nangle_column = \"angle\"\nhanging_angle = 0\nr_b_m = 0.01225\nrole = \"identify\"\n",
+    );
+    let cprs = [1024u32, 4096];
+    toml.push_str(&quantised_decay_run(
+        &camp, 1601, "coarse", cprs[0], "counts",
+    ));
+    toml.push_str(&quantised_decay_run(&camp, 1602, "degrees", cprs[1], "deg"));
+    std::fs::write(camp.join("campaign.toml"), toml).unwrap();
+    let s = run(&DiscoverJob {
+        input: camp,
+        out: dir.path().join("out"),
+        base: Base::Linear,
+        pipeline: None,
+        generations: None,
+        seed: None,
+        progress: false,
+    })
+    .unwrap();
+    eprintln!("{s}");
+    assert_eq!(s.decays.len(), 2);
+    for ((id, d), cpr) in s.decays.iter().zip(cprs) {
+        let q = std::f64::consts::TAU / f64::from(cpr);
+        let res = &d.envelope.resolution;
+        eprintln!("run {id}: {}", res.describe());
+        assert!((res.step_rad / q - 1.0).abs() < 1e-9, "run {id}: {res:?}");
+        assert!(
+            d.envelope.noise_rad >= q / 12f64.sqrt() * (1.0 - 1e-9),
+            "run {id}: noise {} below the quantiser's {}",
+            d.envelope.noise_rad,
+            q / 12f64.sqrt()
+        );
+        let ended = res
+            .ended_at_s
+            .unwrap_or_else(|| panic!("run {id}: the resolution did not end it:\n{d}"));
+        assert!(res.dropped_turning_points > 0, "run {id}: {res:?}");
+        assert!(ended < d.duration_s - 5.0, "run {id}: ended at {ended} s");
+        // Every analysed swing is at least 3 counts.
+        let th: Vec<f64> = d.envelope.rows.iter().map(|r| r.theta_rad).collect();
+        for w in th.windows(2) {
+            let swing = 0.5 * (w[1] - w[0]).abs();
+            assert!(
+                swing >= 3.0 * q,
+                "run {id}: a swing of {:.2} counts",
+                swing / q
+            );
+        }
+        // A gravity pendulum: a period drift at the few-count swings would be the staircase's
+        // timing, not a restoring torque (it was +19.5 % at 3–20 counts before the allowance).
+        assert!(
+            !d.unexplained.iter().any(|u| u.what == "period_drift"),
+            "run {id}: {:?}",
+            d.unexplained
+        );
+        let text = d.to_string();
+        assert!(!text.contains("noise 1.0e-12"), "run {id}:\n{text}");
+        assert!(
+            text.contains("the resolution ended the analysis at t ="),
+            "run {id}:\n{text}"
+        );
+    }
+    let report = std::fs::read_to_string(s.out_dir.join("report.md")).unwrap();
+    assert_eq!(
+        report
+            .matches("the resolution ended the analysis at t =")
+            .count(),
+        2,
+        "{report}"
+    );
+}
+
 /// Issue 12 item 6: `discover` on a free-decay campaign honours `--base` (dry used to give the
 /// linear answer) and writes the figures and tables a shaker campaign gets. Bearing friction and
 /// viscous drag act together, so the dry base lacks the viscous term (named in every run, β

@@ -225,6 +225,10 @@ pub struct DecayOptions {
     /// A term must lower the held-out E_theta by at least this fraction (besides beating the
     /// noise): smaller changes are fit-to-fit variation, not physics.
     pub min_heldout_gain: f64,
+    /// The angle's resolution, rad (2π / counts per revolution), when the capture states it;
+    /// `None` = the smallest step seen in the data. See [`Resolution`].
+    #[serde(default)]
+    pub resolution_rad: Option<f64>,
 }
 
 impl Default for DecayOptions {
@@ -244,6 +248,7 @@ impl Default for DecayOptions {
             max_iter: 40,
             z: 1.96,
             min_heldout_gain: 0.02,
+            resolution_rad: None,
         }
     }
 }
@@ -259,6 +264,53 @@ pub struct TurningPoint {
     pub sample: usize,
     /// False when the parabola could not be trusted (the coarse sample is used).
     pub refined: bool,
+}
+
+/// Swings smaller than this many resolution steps (encoder counts) are not analysed: with the
+/// angle known only to a step q, a turning point is uncertain by about q/√12 after the parabola
+/// and a swing of 1–2 steps is mostly the quantiser's pattern (its period and loss per cycle are
+/// then artefacts: the issue-16 recordings gave period drifts of +5,220 % and negative losses).
+pub const MIN_SWING_STEPS: f64 = 3.0;
+
+/// What the angle's resolution did to the analysis.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Resolution {
+    /// One step of the angle, rad (one encoder count); 0 when the data have no step at all.
+    pub step_rad: f64,
+    /// Where the step comes from: the capture's counts per revolution, or the data.
+    pub source: String,
+    /// The quantiser's noise q/√12, rad: the noise floor is never below it.
+    pub noise_floor_rad: f64,
+    /// Swings (half the distance between successive turning points) below this, rad
+    /// ([`MIN_SWING_STEPS`] steps), end the analysis.
+    pub min_swing_rad: f64,
+    /// The last turning point analysed, s, when smaller swings followed (`None`: every swing
+    /// found was above [`Self::min_swing_rad`]).
+    pub ended_at_s: Option<f64>,
+    /// The swing that ended it, rad.
+    pub ended_swing_rad: Option<f64>,
+    /// Turning points found after the end and left out.
+    pub dropped_turning_points: usize,
+}
+
+impl Resolution {
+    /// One line for the report.
+    pub fn describe(&self) -> String {
+        let head = format!(
+            "resolution: {:.3e} rad per step ({}); noise floor q/√12 = {:.1e} rad; swings below \
+             {MIN_SWING_STEPS} steps ({:.3e} rad) are not analysed",
+            self.step_rad, self.source, self.noise_floor_rad, self.min_swing_rad
+        );
+        match (self.ended_at_s, self.ended_swing_rad) {
+            (Some(t), Some(a)) => format!(
+                "{head}: the resolution ended the analysis at t = {t:.2} s (the next swing, \
+                 {a:.3e} rad, is {:.1} steps; {} later turning points left out)",
+                a / self.step_rad.max(1e-300),
+                self.dropped_turning_points
+            ),
+            _ => format!("{head}: every swing found is above it"),
+        }
+    }
 }
 
 /// One row of the envelope table: turning point n (half swing number n).
@@ -295,8 +347,11 @@ pub struct EnvelopeFit {
     pub rows: Vec<EnvelopeRow>,
     /// The oscillation's centre (median of three-point turning-point averages), rad.
     pub centre_rad: f64,
-    /// Measurement noise (or quantisation) of θ, rad.
+    /// Measurement noise of θ, rad, never below the quantiser's (see `resolution`).
     pub noise_rad: f64,
+    /// The angle's resolution and where it ended the analysis.
+    #[serde(default)]
+    pub resolution: Resolution,
     /// ΔA per cycle = c0 + c1·A + c2·A², all three terms.
     pub polynomial: Vec<Coef>,
     /// The subset of {c0, c1, c2} with the lowest BIC, refitted alone.
@@ -550,58 +605,126 @@ fn median(v: &mut [f64]) -> f64 {
     }
 }
 
-/// Noise of θ: the robust scatter of second differences (white noise: σ·√6), floored by the
-/// quantisation step's σ (q/√12) when the signal is quantised.
-fn noise_level(th: &[f64]) -> (f64, f64) {
-    let mut d2: Vec<f64> = th
-        .windows(3)
-        .map(|w| (w[2] - 2.0 * w[1] + w[0]).abs())
-        .collect();
-    let mad = median(&mut d2) / 0.6745;
-    let sigma_white = mad / 6f64.sqrt();
-    // Quantum: the most common smallest non-zero step.
+/// The angle's step q and where it comes from: `stated` (2π / counts per revolution) when the
+/// capture gives it, else the smallest non-zero step seen.
+fn angle_step(th: &[f64], stated: Option<f64>) -> (f64, String) {
     let mut steps: Vec<f64> = th
         .windows(2)
         .map(|w| (w[1] - w[0]).abs())
         .filter(|d| *d > 0.0)
         .collect();
     steps.sort_by(f64::total_cmp);
-    let q = if steps.is_empty() {
-        0.0
-    } else {
-        // the 2nd percentile: robust against one odd tiny step
-        steps[steps.len() / 50]
+    // The smallest step seen at least 3 times (within 2 %, for values printed with few
+    // digits): one odd tiny step does not set it, and a fast swing, whose steps are mostly
+    // several counts, still shows its single counts near the turning points.
+    let seen = (0..steps.len())
+        .find(|&i| steps.partition_point(|&x| x <= 1.02 * steps[i]) - i >= 3)
+        .map_or(0.0, |i| steps[i]);
+    match stated {
+        Some(q) if q > 0.0 && q.is_finite() => {
+            let mut source = format!(
+                "stated: {:.0} counts per revolution",
+                std::f64::consts::TAU / q
+            );
+            // Steps much finer than the stated count mean the key is wrong (or the data were
+            // smoothed): say so rather than trust either silently.
+            if seen > 0.0 && seen < 0.5 * q {
+                source.push_str(&format!(
+                    "; the data move in finer steps ({seen:.2e} rad): check counts_per_rev"
+                ));
+            }
+            (q, source)
+        }
+        _ => (
+            seen,
+            if seen > 0.0 {
+                format!(
+                    "the smallest step seen in the data, ≈ {:.0} per revolution",
+                    std::f64::consts::TAU / seen
+                )
+            } else {
+                "the data never change".to_string()
+            },
+        ),
+    }
+}
+
+/// Noise of θ: the robust scatter of second differences (white noise: σ·√6), never below the
+/// quantiser's q/√12 (a signal at rest on one count has no scatter at all, which is not a
+/// noise-free measurement).
+fn noise_level(th: &[f64], q: f64) -> f64 {
+    let mut d2: Vec<f64> = th
+        .windows(3)
+        .map(|w| (w[2] - 2.0 * w[1] + w[0]).abs())
+        .collect();
+    let mad = median(&mut d2) / 0.6745;
+    let sigma_white = mad / 6f64.sqrt();
+    sigma_white.max(q / 12f64.sqrt())
+}
+
+/// The noise, the resolution and the turning points of θ(t), cut where the swings fall below
+/// [`MIN_SWING_STEPS`] steps.
+fn resolved_turning_points(
+    t: &[f64],
+    th: &[f64],
+    stated_step_rad: Option<f64>,
+) -> (Vec<TurningPoint>, f64, Resolution) {
+    let (q, source) = angle_step(th, stated_step_rad);
+    let noise = noise_level(th, q);
+    let h = (8.0 * noise).max(3.0 * q);
+    let mut tps = turning_points_h(t, th, h);
+    let mut res = Resolution {
+        step_rad: q,
+        source,
+        noise_floor_rad: q / 12f64.sqrt(),
+        min_swing_rad: MIN_SWING_STEPS * q,
+        ended_at_s: None,
+        ended_swing_rad: None,
+        dropped_turning_points: 0,
     };
-    let quantised = {
-        // Quantised if most steps are multiples of q.
-        q > 0.0
-            && steps
-                .iter()
-                .step_by((steps.len() / 200).max(1))
-                .filter(|d| {
-                    let r = *d / q;
-                    (r - r.round()).abs() < 0.05
-                })
-                .count() as f64
-                > 0.9 * (steps.len() as f64 / (steps.len() / 200).max(1) as f64).floor()
-    };
-    let sigma_q = if quantised { q / 12f64.sqrt() } else { 0.0 };
-    (
-        sigma_white.max(sigma_q).max(1e-12),
-        if quantised { q } else { 0.0 },
-    )
+    let swing = |w: &[TurningPoint]| 0.5 * (w[1].theta_rad - w[0].theta_rad).abs();
+    // From the largest swing on (small wiggles before a hand release are not the decay's end).
+    let from = tps
+        .windows(2)
+        .enumerate()
+        .max_by(|a, b| swing(a.1).total_cmp(&swing(b.1)))
+        .map_or(0, |(i, _)| i);
+    if let Some(n) = tps
+        .windows(2)
+        .enumerate()
+        .skip(from)
+        .find(|(_, w)| swing(w) < res.min_swing_rad)
+        .map(|(i, _)| i)
+    {
+        res.ended_at_s = Some(tps[n].t_s);
+        res.ended_swing_rad = Some(swing(&tps[n..n + 2]));
+        res.dropped_turning_points = tps.len() - (n + 1);
+        tps.truncate(n + 1);
+    }
+    (tps, noise, res)
 }
 
 /// Turning points of θ(t): hysteresis on 8× the noise (so noise and encoder steps do not make
 /// extrema), each refined by a parabola over ±T/12 around it. Extrema whose window reaches the
-/// record's ends are dropped (the record's first sample is not a turning point).
+/// record's ends are dropped (the record's first sample is not a turning point), and so is
+/// everything from the first swing smaller than [`MIN_SWING_STEPS`] steps of the angle's
+/// resolution on (here the smallest step seen; [`turning_points_with`] takes a stated one).
 pub fn turning_points(t_s: &[f64], theta_rad: &[f64]) -> Vec<TurningPoint> {
+    turning_points_with(t_s, theta_rad, None).0
+}
+
+/// [`turning_points`] with the angle's resolution when the capture states it (2π / counts per
+/// revolution), and what the resolution did.
+pub fn turning_points_with(
+    t_s: &[f64],
+    theta_rad: &[f64],
+    resolution_rad: Option<f64>,
+) -> (Vec<TurningPoint>, Resolution) {
     if check_input(t_s, theta_rad).is_err() {
-        return Vec::new();
+        return (Vec::new(), Resolution::default());
     }
-    let (noise, q) = noise_level(theta_rad);
-    let h = (8.0 * noise).max(3.0 * q);
-    turning_points_h(t_s, theta_rad, h)
+    let (tps, _, res) = resolved_turning_points(t_s, theta_rad, resolution_rad);
+    (tps, res)
 }
 
 fn turning_points_h(t: &[f64], th: &[f64], h: f64) -> Vec<TurningPoint> {
@@ -798,13 +921,27 @@ fn bic(rss: f64, n: usize, k: usize) -> f64 {
 /// shape.
 pub fn envelope(t_s: &[f64], theta_rad: &[f64]) -> Result<EnvelopeFit, DecayError> {
     check_input(t_s, theta_rad)?;
-    let tps = turning_points(t_s, theta_rad);
-    let (noise, _) = noise_level(theta_rad);
-    envelope_of(&tps, noise, 1.96)
+    let (tps, noise, res) = resolved_turning_points(t_s, theta_rad, None);
+    envelope_of(&tps, noise, res, 1.96)
 }
 
-fn envelope_of(tps: &[TurningPoint], noise: f64, z: f64) -> Result<EnvelopeFit, DecayError> {
+fn envelope_of(
+    tps: &[TurningPoint],
+    noise: f64,
+    resolution: Resolution,
+    z: f64,
+) -> Result<EnvelopeFit, DecayError> {
     const NEEDED: usize = 6;
+    if tps.len() < NEEDED && resolution.ended_at_s.is_some() {
+        return Err(DecayError::Input(format!(
+            "only {} turning points before the swings fall below {MIN_SWING_STEPS} steps of the \
+             angle's resolution ({:.3e} rad, {}) at t = {:.2} s: need at least {NEEDED}",
+            tps.len(),
+            resolution.step_rad,
+            resolution.source,
+            resolution.ended_at_s.unwrap_or(f64::NAN)
+        )));
+    }
     if tps.len() < NEEDED {
         return Err(DecayError::TooFewSwings {
             found: tps.len(),
@@ -969,6 +1106,7 @@ fn envelope_of(tps: &[TurningPoint], noise: f64, z: f64) -> Result<EnvelopeFit, 
         rows,
         centre_rad: centre,
         noise_rad: noise,
+        resolution,
         polynomial,
         polynomial_best,
         shape,
@@ -1549,10 +1687,8 @@ pub fn diagnose_decay(
     if opts.base.is_empty() && opts.candidates.is_empty() {
         return Err(DecayError::Input("no damping terms to fit".into()));
     }
-    let (noise, q) = noise_level(theta_rad);
-    let h = (8.0 * noise).max(3.0 * q);
-    let tps = turning_points_h(t_s, theta_rad, h);
-    let env = envelope_of(&tps, noise, opts.z)?;
+    let (tps, noise, res) = resolved_turning_points(t_s, theta_rad, opts.resolution_rad);
+    let env = envelope_of(&tps, noise, res, opts.z)?;
     let k = tps.len();
     let mut halves: Vec<f64> = tps.windows(2).map(|w| w[1].t_s - w[0].t_s).collect();
     let half_s = median(&mut halves);
@@ -2116,9 +2252,14 @@ fn unexplained(
         let mut diffs: Vec<f64> = swings.windows(2).map(|p| (p[1].1 - p[0].1).abs()).collect();
         let sigma = 1.4826 * median(&mut diffs) / std::f64::consts::SQRT_2;
         let thr = (5.0 * sigma).max(0.01);
+        // On a staircase of step q a turning point can sit anywhere on the plateau where the
+        // swing stays within one step of its extreme, sqrt(2q/A)/omega_n either side: that
+        // much of the half period (π/omega_n) is the encoder's, not the restoring torque's.
+        let q = env.resolution.step_rad;
+        let allowance = |a: f64| (2.0 * q / a.max(1e-300)).sqrt() / std::f64::consts::PI;
         let off: Vec<&(f64, f64, f64)> = swings
             .iter()
-            .filter(|s| (s.1 - r_ref).abs() > thr)
+            .filter(|s| (s.1 - r_ref).abs() > thr.max(allowance(s.0)))
             .collect();
         if off.len() >= 2 {
             let lo = off.iter().map(|s| s.0).fold(f64::INFINITY, f64::min);
@@ -2345,6 +2486,7 @@ impl fmt::Display for DecayDiagnosis {
             self.best.offset_rad(),
             e.noise_rad
         )?;
+        writeln!(f, "{}", e.resolution.describe())?;
         let poly: Vec<String> = e
             .polynomial
             .iter()
@@ -2514,6 +2656,58 @@ mod tests {
                 "{} vs {a}",
                 p.theta_rad
             );
+        }
+    }
+
+    /// Issue 16 item 2: a 12-bit encoder logged in degrees to 0.01° (steps of 0.08° and 0.09°,
+    /// not multiples of one quantum) that decays to rest. The noise floor is the quantiser's
+    /// (it was 1e-12: at rest the second differences are all 0), no swing under 3 steps is
+    /// analysed, and the stated resolution is used when given.
+    #[test]
+    fn regression_issue_16_noise_floor_and_three_step_rule() {
+        let q = std::f64::consts::TAU / 4096.0;
+        let t: Vec<f64> = (0..30_000).map(|i| i as f64 * 2e-3).collect();
+        let th: Vec<f64> = t
+            .iter()
+            .map(|&t| {
+                let v = 0.3 * (-0.15 * t).exp() * (6.0 * t).cos();
+                let deg = ((v / q).floor() * q).to_degrees();
+                ((deg * 100.0).round() / 100.0).to_radians()
+            })
+            .collect();
+        for stated in [None, Some(q)] {
+            let (tps, res) = turning_points_with(&t, &th, stated);
+            assert!(
+                (res.step_rad / q - 1.0).abs() < 0.1,
+                "{stated:?}: step {} vs {q}",
+                res.step_rad
+            );
+            assert!(
+                res.ended_at_s.is_some() && res.dropped_turning_points > 0,
+                "{res:?}"
+            );
+            for w in tps.windows(2) {
+                let swing = 0.5 * (w[1].theta_rad - w[0].theta_rad).abs();
+                assert!(
+                    swing >= MIN_SWING_STEPS * res.step_rad,
+                    "{swing} at {}",
+                    w[0].t_s
+                );
+            }
+            let d = diagnose_decay(
+                &t,
+                &th,
+                &DecayOptions {
+                    resolution_rad: stated,
+                    candidates: vec![],
+                    ..DecayOptions::default()
+                },
+            )
+            .unwrap();
+            assert!(d.envelope.noise_rad >= res.step_rad / 12f64.sqrt() * (1.0 - 1e-12));
+            let text = d.to_string();
+            assert!(text.contains("the resolution ended the analysis"), "{text}");
+            assert!(!text.contains("noise 1.0e-12"), "{text}");
         }
     }
 }

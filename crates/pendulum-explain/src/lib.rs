@@ -9,7 +9,8 @@ pub mod decay;
 mod linalg;
 
 pub use decay::{
-    diagnose_decay, envelope, omega_n_estimate, turning_points, Candidate, Coef, DecayDiagnosis,
-    DecayError, DecayOptions, EnvelopeFit, EnvelopeRow, Estimate, HeldOutScore, KnownRig, LossBand,
-    ModelFit, ReferenceModel, Term, TurningPoint, Unexplained,
+    diagnose_decay, envelope, omega_n_estimate, turning_points, turning_points_with, Candidate,
+    Coef, DecayDiagnosis, DecayError, DecayOptions, EnvelopeFit, EnvelopeRow, Estimate,
+    HeldOutScore, KnownRig, LossBand, ModelFit, ReferenceModel, Resolution, Term, TurningPoint,
+    Unexplained, MIN_SWING_STEPS,
 };

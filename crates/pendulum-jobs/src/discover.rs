@@ -13,7 +13,7 @@ use pendulum_report::{Column, ColumnData};
 use serde::{Deserialize, Serialize};
 
 use crate::outputs::write_outputs;
-use crate::runs::load_runs;
+use crate::runs::load_runs_resolved;
 use crate::JobError;
 
 /// The built-in discover pipeline (`pipelines/discover.toml`).
@@ -154,9 +154,9 @@ pub fn run(job: &DiscoverJob) -> Result<DiscoverSummary, JobError> {
             .cloned()
             .collect(),
     };
-    let runs = load_runs(&job.input)?;
+    let (runs, steps): (Vec<_>, Vec<_>) = load_runs_resolved(&job.input)?.into_iter().unzip();
     if !runs.is_empty() && runs.iter().all(|r| r.rig.omega_hz.is_none()) {
-        return free_decays(job, &runs, &pipeline_json);
+        return free_decays(job, &runs, &steps, &pipeline_json);
     }
     for role in [Role::Identify, Role::Validate] {
         if !runs.iter().any(|r| r.role == role) {
@@ -415,6 +415,7 @@ pub fn run(job: &DiscoverJob) -> Result<DiscoverSummary, JobError> {
 fn free_decays(
     job: &DiscoverJob,
     runs: &[pendulum_process::RunData],
+    steps: &[Option<f64>],
     pipeline_json: &str,
 ) -> Result<DiscoverSummary, JobError> {
     use pendulum_explain::{diagnose_decay, DecayOptions, KnownRig};
@@ -434,7 +435,7 @@ fn free_decays(
     let (mut c_run, mut c_eff, mut c_acc, mut c_unit, mut c_note) =
         (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
     let mut nums: Vec<Vec<f64>> = vec![Vec::new(); 5];
-    for rd in runs {
+    for (rd, step) in runs.iter().zip(steps) {
         let rig = (rd.rig.m_kg.is_finite() && rd.rig.l_m.is_finite()).then_some(KnownRig {
             m_kg: rd.rig.m_kg,
             a_m: rd.rig.l_m,
@@ -446,6 +447,7 @@ fn free_decays(
             rig,
             base,
             candidates,
+            resolution_rad: *step,
             ..DecayOptions::default()
         };
         let d = diagnose_decay(&rd.enc_t_s, &rd.theta_rad, &opts)

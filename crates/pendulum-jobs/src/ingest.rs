@@ -185,6 +185,11 @@ fn ingest_run(c: &Campaign, spec: &RunSpec, out_dir: &Path) -> Result<IngestRow,
     let t0 = first_t_us(spec, opts)?.unwrap_or(0);
     let mut reader = CaptureReader::open_run(spec, opts)?;
     let mut warnings = Vec::new();
+    // A time base the reader had to rebuild (bursty stamps) is news the user must see, not only
+    // a header key in the MCAP.
+    if let Some(tb) = reader.header().get("time_base") {
+        warnings.push(format!("time base {tb}"));
+    }
     let start_ns = match reader.header().started() {
         Some(s) => match parse_rfc3339_utc_ns(s) {
             Ok(ns) => Some(ns),

@@ -5,7 +5,7 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use pendulum_log::{read_run, RunLog, METADATA_RUN};
+use pendulum_log::{read_run, RunLog, METADATA_CAPTURE_HEADER, METADATA_RUN};
 use pendulum_process::{RigParams, Role, RunData};
 use pendulum_rig::{Campaign, CaptureReader, IngestStats, ReadOptions, RunSpec, Sample};
 
@@ -238,6 +238,15 @@ pub fn source(dir: &Path) -> Result<Source, JobError> {
 
 /// Loads every run of a campaign or MCAP folder (in parallel).
 pub fn load_runs(dir: &Path) -> Result<Vec<RunData>, JobError> {
+    Ok(load_runs_resolved(dir)?
+        .into_iter()
+        .map(|(rd, _)| rd)
+        .collect())
+}
+
+/// [`load_runs`] with each run's angle resolution, rad, when its capture states it (see
+/// [`angle_step_rad`]).
+pub fn load_runs_resolved(dir: &Path) -> Result<Vec<(RunData, Option<f64>)>, JobError> {
     use rayon::prelude::*;
     match source(dir)? {
         Source::Campaign(c) => {
@@ -247,12 +256,45 @@ pub fn load_runs(dir: &Path) -> Result<Vec<RunData>, JobError> {
             }
             c.runs
                 .par_iter()
-                .map(|spec| read_capture(spec, c.g_m_s2).map(|cap| run_data(&c, spec, &cap)))
+                .map(|spec| {
+                    read_capture(spec, c.g_m_s2).map(|cap| {
+                        let step = angle_step_rad(spec.format.as_deref(), &cap.header);
+                        (run_data(&c, spec, &cap), step)
+                    })
+                })
                 .collect()
         }
         Source::Mcap(files) => files
             .par_iter()
-            .map(|p| run_data_from_log(&read_run(p)?))
+            .map(|p| {
+                let log = read_run(p)?;
+                let header: Vec<(String, String)> = log
+                    .metadata
+                    .get(METADATA_CAPTURE_HEADER)
+                    .map(|m| m.clone().into_iter().collect())
+                    .unwrap_or_default();
+                let format = log
+                    .metadata
+                    .get(METADATA_RUN)
+                    .and_then(|m| m.get("format").cloned());
+                let step = angle_step_rad(format.as_deref(), &header);
+                Ok((run_data_from_log(&log)?, step))
+            })
             .collect(),
     }
+}
+
+/// One step of a run's angle, rad (2π / counts per revolution), when its capture states it: the
+/// header's `encoder_cpr` (a time series' `counts_per_rev`, whatever its angle unit), else the
+/// rig's default for the rig's own formats; a time series without `counts_per_rev` states none
+/// (the analysis then takes the smallest step in the data).
+pub fn angle_step_rad(format: Option<&str>, header: &[(String, String)]) -> Option<f64> {
+    let get = |k: &str| header.iter().find(|(key, _)| key == k).map(|(_, v)| v);
+    if let Some(cpr) = get("encoder_cpr").and_then(|v| v.trim().parse::<f64>().ok()) {
+        return (cpr.is_finite() && cpr > 0.0).then(|| std::f64::consts::TAU / cpr);
+    }
+    let timeseries = format == Some(pendulum_rig::timeseries::FORMAT)
+        || get("format").map(String::as_str) == Some(pendulum_rig::timeseries::FORMAT);
+    (!timeseries)
+        .then(|| std::f64::consts::TAU / f64::from(pendulum_rig::capture::DEFAULT_ENCODER_CPR))
 }

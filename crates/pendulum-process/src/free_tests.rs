@@ -144,6 +144,118 @@ fn free_decay_fit_recovers_omega0_and_damping() {
     assert!(fit.runs[0].steady_agrees(), "{:?}", fit.runs[0]);
 }
 
+/// Issue 16 item 4: parameters at their search bounds are reported as such. Nothing of the
+/// linear + bearing fit sits at a bound; the same fit with its encoder offset pinned at the
+/// ±0.05 rad limit gets a note naming it.
+#[test]
+fn regression_issue_16_params_at_bounds_are_reported() {
+    let run = synthetic_decay();
+    let al = align(&run, &AlignConfig::default()).expect("free-decay alignment");
+    let ic = estimate_state(&run, al.t0_s, &IcConfig::default()).expect("initial state");
+    let steady_cfg = SteadyConfig::default();
+    let steady = free_steady_state(&run, al.t0_s, &steady_cfg).expect("steady");
+    let fit = fit_linear_plus(&run, &al, &ic, &steady, FitParam::Mu);
+    let window = Window {
+        window_s: 10.0,
+        sample_hz: 100.0,
+        segment_s: Some(0.5),
+        t_sim_s: None,
+    };
+    let prepared =
+        crate::identify::prepare_run(&run, &al, &ic, &steady, &steady_cfg, &window).unwrap();
+    let runs = std::slice::from_ref(&prepared);
+    let none = crate::identify::params_at_bounds(runs, &fit);
+    assert!(none.is_empty(), "{none:?}");
+    let mut pinned = fit.clone();
+    let k = pinned
+        .spec
+        .params
+        .iter()
+        .position(|p| *p == FitParam::EncoderOffset)
+        .expect("offset fitted");
+    pinned.params[k] = 0.05;
+    let notes = crate::identify::params_at_bounds(runs, &pinned);
+    eprintln!("{notes:?}");
+    assert!(
+        notes.len() == 1
+            && notes[0].contains("encoder_offset")
+            && notes[0].contains("upper bound 0.05"),
+        "{notes:?}"
+    );
+}
+
+/// Issue 16 item 4: free decays whose swings give different ω0 (here 7.0 and 7.0/1.3 rad/s:
+/// the second run's clock stretched) get a note when one ω0 is forced on both; one run alone,
+/// or two runs of one pendulum, get none.
+#[test]
+fn regression_issue_16_shared_omega0_is_warned() {
+    let window = Window {
+        window_s: 10.0,
+        sample_hz: 100.0,
+        segment_s: Some(0.5),
+        t_sim_s: None,
+    };
+    let steady_cfg = SteadyConfig::default();
+    let prepare = |run: &RunData| {
+        let al = align(run, &AlignConfig::default()).expect("alignment");
+        let ic = estimate_state(run, al.t0_s, &IcConfig::default()).expect("initial state");
+        let steady = free_steady_state(run, al.t0_s, &steady_cfg).expect("steady");
+        let p = crate::identify::prepare_run(run, &al, &ic, &steady, &steady_cfg, &window)
+            .expect("prepare");
+        (p, al, ic, steady)
+    };
+    let a = synthetic_decay();
+    let mut b = synthetic_decay();
+    b.id = "slow".into();
+    for t in &mut b.enc_t_s {
+        *t *= 1.3;
+    }
+    let mut a2 = synthetic_decay();
+    a2.id = "again".into();
+    let (pa, al, ic, steady) = prepare(&a);
+    let fit = fit_linear_plus(&a, &al, &ic, &steady, FitParam::Mu);
+    let (pb, ..) = prepare(&b);
+    let (pa2, ..) = prepare(&a2);
+    let notes = crate::identify::shared_omega0_notes(&[pa.clone(), pb], &fit);
+    eprintln!("{notes:?}");
+    assert!(
+        notes.len() == 1 && notes[0].contains("free 7.0") && notes[0].contains("slow 5.3"),
+        "{notes:?}"
+    );
+    assert!(crate::identify::shared_omega0_notes(std::slice::from_ref(&pa), &fit).is_empty());
+    assert!(crate::identify::shared_omega0_notes(&[pa, pa2], &fit).is_empty());
+}
+
+/// Issue 16 item 4: a free decay that comes to rest inside the classified tail is `rest`, not
+/// `oscillation (period 1)`; one still swinging at the end of the capture stays `oscillation`.
+#[test]
+fn regression_issue_16_free_decay_ending_at_rest_is_rest() {
+    use crate::measured::classify_free;
+    // 10 s of tail: swinging (decaying) for the first 3 s, then still on one count.
+    let q = std::f64::consts::TAU / 4096.0;
+    let tail: Vec<f64> = (0..1000)
+        .map(|i| {
+            let t = i as f64 * 0.01;
+            let v = if t < 3.0 {
+                0.05 * (1.0 - t / 3.0) * (7.0 * t).cos()
+            } else {
+                0.0
+            };
+            (v / q).floor() * q
+        })
+        .collect();
+    let s = classify_free(&tail, 0.01);
+    assert_eq!(s.class, SteadyClass::Rest, "{s}");
+    assert_eq!(s.to_string(), "rest");
+    let swinging: Vec<f64> = (0..1000)
+        .map(|i| 0.05 * (7.0 * i as f64 * 0.01).cos())
+        .collect();
+    assert_eq!(
+        classify_free(&swinging, 0.01).class,
+        SteadyClass::Oscillation
+    );
+}
+
 /// The free-decay fit's constant dry torque term (`coulomb_constant` → c per m g l): a decay with
 /// viscous damping and a constant dry torque only, fitted as linear + `coulomb_constant`, gives
 /// back β and c.

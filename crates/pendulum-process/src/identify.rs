@@ -432,6 +432,82 @@ pub fn identify(
     })
 }
 
+/// The fitted parameters that sit at a search bound (within 0.1 % of the bounds' span), in
+/// words: an estimate pinned there is the bound's, not the data's (an encoder offset at its
+/// ±0.05 rad limit, ω0 at ±5 % of the swings' estimate). A damping term at its lower bound 0 is
+/// said too: the fit does not use it, which is a finding, not a measured zero.
+pub fn params_at_bounds(runs: &[PreparedRun], out: &FitOutcome) -> Vec<String> {
+    let objective = StudyObjective {
+        runs,
+        spec: &out.spec,
+        kappa: 1.0,
+        sim: SimOptions::default(),
+        ic_halfwidth: 0.0,
+        fixed_params: None,
+        penalty: false,
+        order: Default::default(),
+    };
+    let bounds = objective.bounds_vec();
+    let mut notes = Vec::new();
+    for ((p, &v), &(lo, hi)) in out.spec.params.iter().zip(&out.params).zip(&bounds) {
+        let tol = 1e-3 * (hi - lo);
+        let at = if v <= lo + tol {
+            Some(("lower", lo))
+        } else if v >= hi - tol {
+            Some(("upper", hi))
+        } else {
+            None
+        };
+        let Some((side, b)) = at else {
+            continue;
+        };
+        let what = if side == "lower" && b == 0.0 {
+            "the fit does not use it (the estimate is the bound, not a measured 0)".to_string()
+        } else {
+            format!(
+                "the estimate is the bound's, not the data's: the search range [{lo:.4}, {hi:.4}] {} \
+                 cut the fit short (or the model lacks what the fit tries to absorb with it)",
+                p.unit()
+            )
+        };
+        notes.push(format!(
+            "fit {}: {} = {v:.4e} {} sits at its {side} bound {b:.4}: {what}",
+            out.spec.name,
+            p.name(),
+            p.unit()
+        ));
+    }
+    notes
+}
+
+/// Free decays share one ω0 in a fit. When the runs' own ω0 (from their swing periods, good to
+/// about 0.1 %) differ by more than 1 %, that shared value fits none of them: say so, with each
+/// run's ω0 (two recordings of 29.7 and 17.3 rad/s were fitted with 22.4 in silence).
+pub fn shared_omega0_notes(runs: &[PreparedRun], out: &FitOutcome) -> Vec<String> {
+    if runs.len() < 2 || !out.spec.params.contains(&FitParam::Omega0) {
+        return Vec::new();
+    }
+    let w: Vec<f64> = runs.iter().map(|r| r.omega0_rad_s).collect();
+    let (lo, hi) = w.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |a, &v| {
+        (a.0.min(v), a.1.max(v))
+    });
+    if !(hi / lo - 1.0 > 0.01) {
+        return Vec::new();
+    }
+    let each: Vec<String> = runs
+        .iter()
+        .map(|r| format!("{} {:.3} rad/s", r.id, r.omega0_rad_s))
+        .collect();
+    vec![format!(
+        "fit {}: one omega0 ({:.3} rad/s) is forced on runs whose swings say {} ({:+.1} % apart): \
+         they are not one pendulum (or not one set-up); fit them separately",
+        out.spec.name,
+        out.param(FitParam::Omega0),
+        each.join(", "),
+        100.0 * (hi / lo - 1.0)
+    )]
+}
+
 /// The model to fit or validate on `runs`: a free-decay campaign gets the spec's identifiable
 /// counterpart ([`ModelSpec::free_decay`]); free decays and shaker runs cannot share one fit.
 pub fn spec_for_runs(

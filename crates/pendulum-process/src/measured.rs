@@ -66,8 +66,8 @@ pub fn measured_steady_state(
 }
 
 /// Class of a free decay's tail (no forcing period to take a Poincaré section with): `rest` when
-/// θ stays within `rest_tol_rad` of its mean over the tail, else `oscillation` (the capture ended
-/// while it still swung). The tail is the last `tail_s` but at most a quarter of the record from
+/// θ stays within `rest_tol_rad` of its mean over the tail's second half (see
+/// [`classify_free`]), else `oscillation` (the capture ended while it still swung). The tail is the last `tail_s` but at most a quarter of the record from
 /// `t_from_s`: a decay is mostly transient, and `tail_s` is sized for forced runs.
 pub fn free_steady_state(
     run: &RunData,
@@ -83,11 +83,14 @@ pub fn free_steady_state(
     Ok(classify_free(&run.theta_rad[lo..], cfg.rest_tol_rad))
 }
 
-/// `rest` when the angles stay within `rest_tol` of their mean, else `oscillation`.
+/// `rest` when the angles of the tail's second half stay within `rest_tol` of their mean (the
+/// decay came to rest inside the tail: its last swings before stopping are no steady
+/// oscillation), else `oscillation`. Measured and simulated tails go through the same rule.
 pub fn classify_free(theta: &[f64], rest_tol: f64) -> SteadyState {
-    let n = theta.len().max(1) as f64;
-    let mean = theta.iter().sum::<f64>() / n;
-    let still = theta.iter().all(|v| (v - mean).abs() <= rest_tol);
+    let settled = &theta[theta.len() / 2..];
+    let n = settled.len().max(1) as f64;
+    let mean = settled.iter().sum::<f64>() / n;
+    let still = settled.iter().all(|v| (v - mean).abs() <= rest_tol);
     SteadyState {
         class: if still {
             SteadyClass::Rest

@@ -275,6 +275,10 @@ impl Stage for FitStage {
     fn run(&self, ctx: &mut Context) -> Result<(), ProcessError> {
         let runs = ctx.prepared(Role::Identify, &self.0.window, self.name())?;
         let out = identify(&runs, &self.0, ctx.progress.clone())?;
+        ctx.notes
+            .extend(crate::identify::shared_omega0_notes(&runs, &out));
+        ctx.notes
+            .extend(crate::identify::params_at_bounds(&runs, &out));
         ctx.fits.push(out);
         Ok(())
     }

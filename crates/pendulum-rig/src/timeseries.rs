@@ -28,6 +28,15 @@
 //! line number; a time that does not increase is reported and its line skipped; a time that jumps
 //! ahead is believed only if the following lines continue from it; gaps are counted.
 //!
+//! Bursty stamps: when a third or more of the rows repeat the previous row's stamp (a host that
+//! reads the serial buffer every ~60 ms and stamps all it got with the time of the read), the
+//! stamps are not the samples' times. The reader then measures the steady rate over the bursts
+//! (rows of bursts 2..K / time from stamp 1 to stamp K, over the first 50,000 rows; the median
+//! over bursts when the two disagree by more than 5 %, i.e. samples were lost), or takes
+//! `sample_hz` when given, and times each row as `t0 + row index / rate` (re-anchored on the
+//! stamps after lost samples). The header's `time_base` says so, with the rate. Too few bursts to
+//! measure a rate and no `sample_hz`: the file is refused with a message naming the problem.
+//!
 //! What a sample becomes: `EncoderSample { t_us: time·1e6 (or index / sample_hz ·1e6),
 //! theta_rad: (angle − hanging_angle) in rad, count: the count relative to hanging for
 //! `counts`, floor(θ·cpr/2π) when `counts_per_rev` is given with another unit, else 0 }`, and,
@@ -73,6 +82,15 @@ pub const TIMESERIES_KEYS: [&str; 12] = [
 const MAX_LINE_BYTES: usize = 64 * 1024;
 /// Rows looked at to estimate the nominal sample period when only a time column is given.
 const RATE_PROBE_ROWS: usize = 33;
+/// Stamps are bursty when at least this fraction of the probed rows repeat the previous row's
+/// stamp (a file with an odd duplicated stamp is not bursty: that row is skipped as before).
+const BURSTY_REPEAT_FRACTION: f64 = 1.0 / 3.0;
+/// Rows read ahead to measure the steady rate of bursty stamps (or the whole file if shorter):
+/// at ~260 Hz, over three minutes, so the rate's error (one burst's jitter over the span) is far
+/// below 1 %.
+const BURST_PROBE_ROWS: usize = 50_000;
+/// Bursts needed to measure a rate.
+const MIN_BURSTS: usize = 4;
 
 /// The unit of the angle column.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -138,8 +156,9 @@ pub struct TimeseriesSpec {
     pub time_column: Option<String>,
     /// Seconds per unit of the time column (1, 1e-3 or 1e-6).
     pub time_scale_s: f64,
-    /// The sample rate: the time base without a time column, the nominal rate (for gap
-    /// reports) with one.
+    /// The sample rate: the time base without a time column; with one, the nominal rate (for
+    /// gap reports), and the time base when the stamps come in bursts (it overrides the rate
+    /// measured over the bursts).
     pub sample_hz: Option<f64>,
     pub angle_column: String,
     pub angle_unit: AngleUnit,
@@ -313,6 +332,8 @@ impl TimeseriesSpec {
 struct Row {
     line: u64,
     bytes: u64,
+    /// Data-line index (damaged lines count: they were samples too).
+    index: u64,
     /// Seconds, as in the file (time column) or from the data-line index.
     t_s: f64,
     angle: f64,
@@ -347,6 +368,156 @@ pub struct TimeseriesReader<R: BufRead> {
     gaps: GapTracker,
     pending_accel: Option<AccelSample>,
     stats: IngestStats,
+    /// Bursty stamps: times come from the steady rate instead (see [`BurstClock`]). Boxed: the
+    /// reader is one variant of `CaptureReader`, whose variants should stay alike in size.
+    bursts: Option<Box<BurstClock>>,
+}
+
+/// The time base of a file whose stamps come in bursts (a host that reads the serial buffer
+/// every few tens of ms and stamps every row it got with the time of the read, no sample lost):
+/// a row's time is `t0 + index / rate_hz`, the rate measured over the bursts (or `sample_hz`).
+#[derive(Debug, Clone, PartialEq)]
+struct BurstClock {
+    rate_hz: f64,
+    t0_s: f64,
+    /// Median of (stamp − reconstructed time) over the probe: how long a row waits for its read.
+    lag_s: f64,
+    /// Stamps ahead of the reconstructed time by more than this mean lost samples: the clock
+    /// is re-anchored on the stamps.
+    gap_s: f64,
+    /// Whether lost samples re-anchor the clock on the stamps: not with a rate the campaign
+    /// gives (`sample_hz`), which the stamps may contradict (its drift against them would look
+    /// like gaps).
+    reanchor: bool,
+    last_stamp_s: Option<f64>,
+}
+
+/// What the probe found about bursty stamps.
+#[derive(Debug, Clone, PartialEq)]
+struct BurstStats {
+    /// Rate = rows / elapsed time over the complete bursts (lost reads left out), Hz.
+    rate_hz: f64,
+    /// Median over bursts of (rows in the burst / time since the previous stamp), Hz.
+    median_rate_hz: f64,
+    bursts: usize,
+    rows_per_stamp: f64,
+    /// Median time between stamps, s.
+    interval_s: f64,
+}
+
+/// Bursts of equal stamps among `rows` (file order): the measured rate, or why there is none.
+/// Rows of burst k were sampled after stamp k−1 and up to stamp k, so the rate counts the rows
+/// of bursts 2..K over the time from stamp 1 to stamp K (the first burst may be partial and the
+/// last one cut by the probe), leaving out bursts after a read period longer than 1.5 times the
+/// median (lost reads).
+fn burst_stats(rows: &[Row]) -> Result<BurstStats, String> {
+    // (stamp, index of the burst's first row)
+    let mut starts: Vec<(f64, u64)> = Vec::new();
+    for r in rows {
+        match starts.last() {
+            Some(&(s, _)) if r.t_s == s => {}
+            Some(&(s, _)) if r.t_s < s => {}
+            _ => starts.push((r.t_s, r.index)),
+        }
+    }
+    // Complete bursts with the interval that ends at their stamp: 2..K (the K+1-th start
+    // closes burst K).
+    if starts.len() < MIN_BURSTS + 2 {
+        return Err(format!(
+            "only {} distinct stamps among the first {} rows: too few bursts to measure the rate",
+            starts.len(),
+            rows.len()
+        ));
+    }
+    let k = starts.len() - 1; // starts[k] closes burst k−1 (0-based bursts 1..k−1 complete)
+                              // (rows, time since the previous stamp) of each complete burst
+    let bursts: Vec<(f64, f64)> = (1..k)
+        .map(|j| {
+            (
+                (starts[j + 1].1 - starts[j].1) as f64,
+                starts[j].0 - starts[j - 1].0,
+            )
+        })
+        .collect();
+    let mut iv: Vec<f64> = bursts.iter().map(|b| b.1).collect();
+    iv.sort_by(f64::total_cmp);
+    let interval_s = iv[iv.len() / 2];
+    // Reads whose rows were lost leave a long interval before the next stamp with an ordinary
+    // burst: rows / time over them would make the rate too low, so they are left out.
+    let kept: Vec<&(f64, f64)> = bursts.iter().filter(|b| b.1 <= 1.5 * interval_s).collect();
+    let rows_counted: f64 = kept.iter().map(|b| b.0).sum();
+    let elapsed: f64 = kept.iter().map(|b| b.1).sum();
+    if !(elapsed > 0.0 && rows_counted > 0.0) {
+        return Err("the stamps do not advance".into());
+    }
+    let mut per: Vec<f64> = bursts
+        .iter()
+        .filter(|b| b.1 > 0.0)
+        .map(|b| b.0 / b.1)
+        .collect();
+    per.sort_by(f64::total_cmp);
+    Ok(BurstStats {
+        rate_hz: rows_counted / elapsed,
+        median_rate_hz: per[per.len() / 2],
+        bursts: kept.len(),
+        rows_per_stamp: rows_counted / kept.len() as f64,
+        interval_s,
+    })
+}
+
+impl BurstClock {
+    /// The clock for the probed rows at `rate_hz`: t0 puts every probed row at or before its
+    /// stamp (a row is read after it was sampled), the lag is the probe's median wait.
+    fn new(rows: &[Row], rate_hz: f64, interval_s: f64, reanchor: bool) -> Self {
+        let t0_s = rows
+            .iter()
+            .map(|r| r.t_s - r.index as f64 / rate_hz)
+            .fold(f64::INFINITY, f64::min);
+        let mut lags: Vec<f64> = rows
+            .iter()
+            .map(|r| r.t_s - (t0_s + r.index as f64 / rate_hz))
+            .collect();
+        lags.sort_by(f64::total_cmp);
+        Self {
+            rate_hz,
+            t0_s,
+            lag_s: lags.get(lags.len() / 2).copied().unwrap_or(0.0),
+            gap_s: 4.0 * interval_s + 10.0 / rate_hz,
+            reanchor,
+            last_stamp_s: None,
+        }
+    }
+
+    /// The time of a row, or why its stamp cannot be believed. `confirmed`: the next line's stamp
+    /// is not earlier than this one's (a garbled stamp far ahead must not move the clock).
+    fn place(&mut self, r: &Row, confirmed: bool) -> Result<f64, String> {
+        if let Some(prev) = self.last_stamp_s {
+            if r.t_s < prev {
+                return Err(format!(
+                    "time stamp goes backwards: {} s after {} s",
+                    round_sig(r.t_s),
+                    round_sig(prev)
+                ));
+            }
+        }
+        let mut t = self.t0_s + r.index as f64 / self.rate_hz;
+        let lead = r.t_s - t;
+        if self.reanchor && lead - self.lag_s > self.gap_s {
+            if !confirmed {
+                return Err(format!(
+                    "time stamp jumps ahead ({} s, the rows' clock says {} s) and the next \
+                     line does not follow",
+                    round_sig(r.t_s),
+                    round_sig(t)
+                ));
+            }
+            // Samples were lost: the stamps, not the row count, say when this row was.
+            self.t0_s += lead - self.lag_s;
+            t = self.t0_s + r.index as f64 / self.rate_hz;
+        }
+        self.last_stamp_s = Some(r.t_s);
+        Ok(t)
+    }
 }
 
 impl TimeseriesReader<io::BufReader<std::fs::File>> {
@@ -402,20 +573,21 @@ impl<R: BufRead> TimeseriesReader<R> {
             gaps: GapTracker::new("timeseries", 1.0, 1.0),
             pending_accel: None,
             stats: IngestStats::default(),
+            bursts: None,
         };
         let column_line = me.read_header()?;
         me.find_columns(column_line)?;
         me.fill_header();
-        // The nominal period: the sample rate if given, else the median step of the first rows.
-        me.period_s = match me.spec.sample_hz {
-            Some(hz) => 1.0 / hz,
-            None => {
-                while me.lookahead.len() < RATE_PROBE_ROWS && !me.drained {
-                    match me.next_row()? {
-                        Some(r) => me.lookahead.push_back(r),
-                        None => me.drained = true,
-                    }
-                }
+        if me.idx_time.is_some() {
+            me.fill_lookahead(RATE_PROBE_ROWS)?;
+            me.detect_bursts(column_line)?;
+        }
+        // The nominal period: the burst clock's rate, the sample rate if given, else the median
+        // step of the first rows.
+        me.period_s = match (&me.bursts, me.spec.sample_hz) {
+            (Some(b), _) => 1.0 / b.rate_hz,
+            (None, Some(hz)) => 1.0 / hz,
+            (None, None) => {
                 let mut steps: Vec<f64> = me
                     .lookahead
                     .iter()
@@ -439,6 +611,114 @@ impl<R: BufRead> TimeseriesReader<R> {
 
     pub fn header(&self) -> &Header {
         &self.header
+    }
+
+    /// Reads ahead until `rows` parsed rows wait in the lookahead (or the file ends).
+    fn fill_lookahead(&mut self, rows: usize) -> Result<(), RigError> {
+        while self.lookahead.len() < rows && !self.drained {
+            match self.next_row()? {
+                Some(r) => self.lookahead.push_back(r),
+                None => self.drained = true,
+            }
+        }
+        Ok(())
+    }
+
+    /// Repeated stamps: when many rows share their stamp with the previous row, the stamps are
+    /// the times a host read a buffer, not the samples' times. The time is then reconstructed
+    /// from the steady rate (measured over the bursts, or `sample_hz` when given) and the header
+    /// says so (`time_base`); without enough bursts to measure a rate and no `sample_hz`, the
+    /// file is refused with a message naming the problem, rather than read as a handful of rows.
+    fn detect_bursts(&mut self, column_line: u64) -> Result<(), RigError> {
+        let steps = self.lookahead.len().saturating_sub(1);
+        let repeats = self
+            .lookahead
+            .iter()
+            .zip(self.lookahead.iter().skip(1))
+            .filter(|(a, b)| b.t_s == a.t_s)
+            .count();
+        if steps < 2 || (repeats as f64) < BURSTY_REPEAT_FRACTION * steps as f64 {
+            return Ok(());
+        }
+        self.fill_lookahead(BURST_PROBE_ROWS)?;
+        let rows: Vec<Row> = self.lookahead.iter().copied().collect();
+        let repeats = rows.windows(2).filter(|w| w[1].t_s == w[0].t_s).count();
+        let col = self.spec.time_column.clone().unwrap_or_default();
+        let measured = burst_stats(&rows);
+        let (rate_hz, interval_s) = match (&measured, self.spec.sample_hz) {
+            (_, Some(hz)) => (hz, measured.as_ref().map_or(0.0, |b| b.interval_s)),
+            (Ok(b), None) => {
+                // Lost samples inside the probe make rows/time too low; the median over bursts
+                // does not see them.
+                let rate = if (b.rate_hz / b.median_rate_hz - 1.0).abs() <= 0.05 {
+                    b.rate_hz
+                } else {
+                    b.median_rate_hz
+                };
+                (rate, b.interval_s)
+            }
+            (Err(why), None) => {
+                return Err(self.not_a_capture(
+                    column_line,
+                    format!(
+                        "time column `{col}`: {repeats} of {} rows repeat the previous row's \
+                         stamp (stamps in bursts: a host reading a buffer?) and {why}; give \
+                         `sample_hz` (the rate the samples were taken at) to read the file",
+                        rows.len()
+                    ),
+                ))
+            }
+        };
+        let mut note = match &measured {
+            Ok(b) => format!(
+                "reconstructed from the sample rate: the `{col}` stamps come in bursts ({:.1} \
+                 rows per stamp, one stamp every {:.1} ms; {repeats} of the first {} rows repeat \
+                 the previous stamp), so t = row index / {} Hz; measured over {} bursts: {} Hz \
+                 (rows / elapsed time), median over bursts {} Hz",
+                b.rows_per_stamp,
+                1e3 * b.interval_s,
+                rows.len(),
+                round_sig(rate_hz),
+                b.bursts,
+                round_sig(b.rate_hz),
+                round_sig(b.median_rate_hz)
+            ),
+            Err(why) => format!(
+                "reconstructed from the sample rate: the `{col}` stamps repeat ({repeats} of the \
+                 first {} rows) and {why}, so t = row index / {} Hz",
+                rows.len(),
+                round_sig(rate_hz)
+            ),
+        };
+        if let Some(hz) = self.spec.sample_hz {
+            note.push_str(&format!("; the rate is the campaign's sample_hz = {hz}"));
+            if let Ok(b) = &measured {
+                let off = b.rate_hz / hz - 1.0;
+                if off.abs() > 0.01 {
+                    note.push_str(&format!(
+                        ", {:+.1} % off the stamps' rate (check sample_hz)",
+                        -100.0 * off / (1.0 + off)
+                    ));
+                }
+            }
+        }
+        self.header.set("time_base", note);
+        if let Ok(b) = &measured {
+            self.header
+                .set("sample_hz_measured", format!("{}", round_sig(b.rate_hz)));
+        }
+        // The anchor: the rows before the first lost read (a stamp interval over 1.5 times the
+        // usual), at most 2,000: later rows would pull the typical wait up by the gap.
+        let given = self.spec.sample_hz.is_some();
+        let first_gap = rows
+            .windows(2)
+            .position(|w| interval_s > 0.0 && w[1].t_s - w[0].t_s > 1.5 * interval_s)
+            .map_or(rows.len(), |i| i + 1);
+        let anchor = &rows[..first_gap.clamp(1, 2000)];
+        self.bursts = Some(Box::new(BurstClock::new(
+            anchor, rate_hz, interval_s, !given,
+        )));
+        Ok(())
     }
 
     pub fn stats(&self) -> &IngestStats {
@@ -580,8 +860,10 @@ impl<R: BufRead> TimeseriesReader<R> {
         h.set("angle_column", s.angle_column.clone());
         h.set("angle_unit", s.angle_unit.as_str());
         h.set("hanging_angle", format!("{}", s.hanging_angle));
+        // With any angle unit: the analysis takes the angle's resolution from it (issue 16).
         if let Some(cpr) = s.counts_per_rev {
             h.set("encoder_cpr", format!("{cpr}"));
+            h.set("angle_resolution_rad", format!("{}", round_sig(TAU / cpr)));
         }
         if s.has_accel() {
             let names = ["x", "y", "z"];
@@ -644,6 +926,7 @@ impl<R: BufRead> TimeseriesReader<R> {
                     return Ok(Some(Row {
                         line: info.number,
                         bytes: info.bytes,
+                        index,
                         t_s,
                         angle,
                         accel,
@@ -714,20 +997,39 @@ impl<R: BufRead> TimeseriesReader<R> {
             let Some(cand) = self.lookahead.pop_front() else {
                 return Ok(None);
             };
-            if let Err(why) = self.check_time(&cand) {
-                self.stats.skip(Location::Line(cand.line), why, cand.bytes);
-                continue;
-            }
-            self.last_t_s = Some(cand.t_s);
-            let origin = *self.t_origin_s.get_or_insert(cand.t_s.min(0.0));
-            let t_us = ((cand.t_s - origin) * 1e6).round().max(0.0) as u64;
+            let placed = match self.bursts.as_mut() {
+                Some(b) => {
+                    let confirmed = self.lookahead.front().is_none_or(|r| r.t_s >= cand.t_s);
+                    b.place(&cand, confirmed)
+                }
+                None => self.check_time(&cand).map(|()| cand.t_s),
+            };
+            let t_s = match placed {
+                Ok(t) => t,
+                Err(why) => {
+                    self.stats.skip(Location::Line(cand.line), why, cand.bytes);
+                    continue;
+                }
+            };
+            self.last_t_s = Some(t_s);
+            let origin = *self.t_origin_s.get_or_insert(t_s.min(0.0));
+            let t_us = ((t_s - origin) * 1e6).round().max(0.0) as u64;
             self.gaps.step(t_us, &mut self.stats);
             let t_us_raw = (t_us & u64::from(u32::MAX)) as u32;
             let rel = cand.angle - self.spec.hanging_angle;
             let theta_rad = rel * self.rad_per_unit;
             let count: i64 = match (self.spec.angle_unit, self.spec.counts_per_rev) {
                 (AngleUnit::Counts, _) => rel.round() as i64,
-                (_, Some(cpr)) => (theta_rad * cpr / TAU).floor() as i64,
+                (_, Some(cpr)) => {
+                    // floor(θ·cpr/2π) as the rig's firmware counts; a value printed on the grid
+                    // (k·360/cpr degrees) must give k, not k − 1 from the last bit.
+                    let x = theta_rad * cpr / TAU;
+                    if (x - x.round()).abs() < 1e-6 {
+                        x.round() as i64
+                    } else {
+                        x.floor() as i64
+                    }
+                }
                 (_, None) => 0,
             };
             self.stats.encoder_samples += 1;
@@ -1017,6 +1319,124 @@ mod tests {
             .unwrap()
             .to_string();
         assert!(e.contains("n.csv") && e.contains("column-name"), "{e}");
+    }
+
+    /// A host that reads the serial buffer every ~62 ms and stamps every row it got with the
+    /// time of the read: `rows` samples at `rate_hz`, stamps in ms; the reads numbered in `lost`
+    /// lose their rows. Returns the text and each written row's true time, s.
+    fn bursty_csv(
+        rate_hz: f64,
+        rows: usize,
+        jitter_ms: f64,
+        lost: std::ops::Range<usize>,
+    ) -> (String, Vec<f64>) {
+        let mut text = String::from("# host=laptop\nt_ms,angle_deg\n");
+        let mut truth = Vec::new();
+        let mut read_at = 62.0;
+        let mut k = 0usize;
+        let mut i = 0usize;
+        while i < rows {
+            // every sample taken by the read time goes out with that stamp
+            while i < rows && (i as f64) * 1e3 / rate_hz <= read_at {
+                let t = i as f64 / rate_hz;
+                let deg = 20.0 * (-0.05 * t).exp() * (9.0 * t).cos();
+                if !lost.contains(&k) {
+                    text.push_str(&format!(
+                        "{read_at:.0},{:.3}\n",
+                        (deg / 0.088).round() * 0.088
+                    ));
+                    truth.push(t);
+                }
+                i += 1;
+            }
+            k += 1;
+            // a reproducible ±jitter around the 62 ms period
+            let u = ((k * 7919) % 101) as f64 / 100.0 - 0.5;
+            read_at += 62.0 + 2.0 * jitter_ms * u;
+        }
+        (text, truth)
+    }
+
+    /// Issue 16 item 3: bursty stamps (15–16 rows share one, no sample lost) keep every row,
+    /// times rebuilt from the rate measured over the bursts (within 1 %), and the header says so.
+    #[test]
+    fn regression_issue_16_bursty_stamps_keep_every_row() {
+        let rate = 259.3;
+        let (text, _) = bursty_csv(rate, 7625, 4.0, 0..0);
+        let s = spec("time_column = \"t_ms\"\ntime_unit = \"ms\"\nangle_column = \"angle_deg\"\nangle_unit = \"deg\"");
+        let (v, st, h) = read_all(&text, s);
+        let e = enc(&v);
+        assert_eq!(e.len(), 7625, "{:?}", st.skips);
+        assert_eq!(st.skipped_lines_or_frames, 0, "{:?}", st.skips);
+        assert_eq!(st.gap_count, 0, "{:?}", st.gaps);
+        let measured: f64 = h.get("sample_hz_measured").unwrap().parse().unwrap();
+        assert!(
+            (measured / rate - 1.0).abs() < 0.01,
+            "measured {measured} Hz"
+        );
+        let span_s = (e[e.len() - 1].t_us - e[0].t_us) as f64 * 1e-6;
+        let recovered = (e.len() - 1) as f64 / span_s;
+        assert!(
+            (recovered / rate - 1.0).abs() < 0.01,
+            "rows say {recovered} Hz"
+        );
+        assert!(e.windows(2).all(|w| w[1].t_us > w[0].t_us));
+        let tb = h.get("time_base").unwrap();
+        assert!(tb.contains("bursts") && tb.contains("Hz"), "{tb}");
+        eprintln!("time_base = {tb}");
+
+        // `sample_hz` overrides the measured rate.
+        let s = spec("time_column = \"t_ms\"\ntime_unit = \"ms\"\nangle_column = \"angle_deg\"\nangle_unit = \"deg\"\nsample_hz = 250");
+        let (v, _, h) = read_all(&text, s);
+        let e = enc(&v);
+        assert_eq!(e.len(), 7625);
+        assert_eq!(e[250].t_us - e[0].t_us, 1_000_000);
+        assert!(h.get("time_base").unwrap().contains("sample_hz = 250"));
+
+        // Reads 300–304 lost (after the probe would be the same): a gap, the clock re-anchored
+        // on the stamps, every later row within one read period of its true time.
+        let (lossy, truth) = bursty_csv(rate, 30_000, 4.0, 300..305);
+        let s = spec("time_column = \"t_ms\"\ntime_unit = \"ms\"\nangle_column = \"angle_deg\"\nangle_unit = \"deg\"");
+        let (v, st, h) = read_all(&lossy, s);
+        eprintln!("lossy: {:?}", h.get("time_base"));
+        let e = enc(&v);
+        assert_eq!(e.len(), truth.len(), "{:?}", st.skips);
+        assert_eq!(st.gap_count, 1, "{:?}", st.gaps);
+        let worst = e
+            .iter()
+            .zip(&truth)
+            .map(|(x, t)| ((x.t_us - e[0].t_us) as f64 * 1e-6 - (t - truth[0])).abs())
+            .fold(0.0, f64::max);
+        assert!(worst < 0.062, "a row {worst} s off its time");
+
+        // Too few bursts to measure a rate and no sample_hz: refused, naming the problem.
+        let short: String = text.lines().take(40).map(|l| format!("{l}\n")).collect();
+        let s = spec("time_column = \"t_ms\"\ntime_unit = \"ms\"\nangle_column = \"angle_deg\"\nangle_unit = \"deg\"");
+        let err = TimeseriesReader::new(short.as_bytes(), "b.csv", s, ReadOptions::default())
+            .err()
+            .unwrap()
+            .to_string();
+        assert!(
+            err.contains("b.csv") && err.contains("stamp") && err.contains("sample_hz"),
+            "{err}"
+        );
+    }
+
+    /// Issue 16 item 4: `counts_per_rev` with degrees is honoured (the count and the header's
+    /// resolution), a value on the grid giving its own count.
+    #[test]
+    fn regression_issue_16_counts_per_rev_with_degrees() {
+        let s = spec(
+            "sample_hz = 100\nangle_column = \"a\"\nangle_unit = \"deg\"\ncounts_per_rev = 4096",
+        );
+        let step = 360.0 / 4096.0;
+        let text = format!("a\n0\n{}\n{}\n", 3.0 * step, -5.0 * step);
+        let (v, _, h) = read_all(&text, s);
+        let e = enc(&v);
+        assert_eq!(e.iter().map(|x| x.count).collect::<Vec<_>>(), [0, 3, -5]);
+        assert_eq!(h.get("encoder_cpr"), Some("4096"));
+        let q: f64 = h.get("angle_resolution_rad").unwrap().parse().unwrap();
+        assert!((q - TAU / 4096.0).abs() < 1e-12);
     }
 
     const CAMPAIGN: &str = r#"
