@@ -564,13 +564,34 @@ fn survey_issue_5_every_effect() {
     );
 }
 
+/// A free decay of `phys` (no shaker) released at rest from `theta0`, sampled at 200 Hz for
+/// `duration_s`: (t s, θ rad), from the model's own simulator.
+fn free_decay(
+    phys: &pendulum_model::Physical,
+    theta0: f64,
+    duration_s: f64,
+) -> (Vec<f64>, Vec<f64>) {
+    use pendulum_model::{Model, SimOptions};
+    let w0 = phys.omega0_rad_s();
+    let tr = pendulum_model::sim::simulate(
+        &Model::new(phys.to_dimensionless()),
+        &SimOptions::default(),
+        [theta0, 0.0],
+        0.0,
+        duration_s * w0,
+        w0 / 200.0,
+    )
+    .unwrap();
+    (tr.t.iter().map(|tau| tau / w0).collect(), tr.theta)
+}
+
 /// A free-decay campaign (no shaker, `format = "timeseries"`) written from the model's own
 /// simulator over drawn designs: per run a bob of rig.md (mass, length), a hand start (a swing of
 /// 0.8–2.5 rad either way), 20–30 s at 200 Hz, the angle as 4096-count encoder readings (rig.md's
 /// encoder) stamped with ±20 µs jitter. Bearing friction μ (r_b = 12.25 mm) and viscous drag b
 /// act in every run. Returns each run's dimensionless β = b/(m ω0) for the truth.
 fn free_decay_campaign(dir: &Path, seed: u64, b: f64, mu: f64) -> Vec<f64> {
-    use pendulum_model::{Model, Physical, SimOptions};
+    use pendulum_model::Physical;
     use pendulum_rig::twin::{BOB_LENGTH_RANGE_M, BOB_MASSES_KG};
     let mut r = rng(seed);
     std::fs::create_dir_all(dir).unwrap();
@@ -589,22 +610,12 @@ fn free_decay_campaign(dir: &Path, seed: u64, b: f64, mu: f64) -> Vec<f64> {
             mu,
             ..Physical::default()
         };
-        let w0 = phys.omega0_rad_s();
         let theta0 = r.random_range(0.8..2.5) * if r.random::<bool>() { 1.0 } else { -1.0 };
         let duration_s = r.random_range(20.0..30.0);
-        let model = Model::new(phys.to_dimensionless());
-        let tr = pendulum_model::sim::simulate(
-            &model,
-            &SimOptions::default(),
-            [theta0, 0.0],
-            0.0,
-            duration_s * w0,
-            w0 / 200.0,
-        )
-        .unwrap();
+        let (ts, thetas) = free_decay(&phys, theta0, duration_s);
         let mut csv = String::from("t_s,count\n");
-        for (tau, th) in tr.t.iter().zip(&tr.theta) {
-            let stamp = tau / w0 + r.random_range(-20e-6..20e-6);
+        for (t_s, th) in ts.iter().zip(&thetas) {
+            let stamp = t_s + r.random_range(-20e-6..20e-6);
             let count = (th * 4096.0 / std::f64::consts::TAU).floor() as i64;
             csv.push_str(&format!("{stamp:.6},{count}\n"));
         }
@@ -630,7 +641,7 @@ fn free_decay_campaign(dir: &Path, seed: u64, b: f64, mu: f64) -> Vec<f64> {
 /// `counts_per_rev = cpr` in either case. Little dry friction, so the last swings shrink through
 /// the few-count range instead of stopping at once.
 fn quantised_decay_run(dir: &Path, seed: u64, id: &str, cpr: u32, unit: &str) -> String {
-    use pendulum_model::{Model, Physical, SimOptions};
+    use pendulum_model::Physical;
     let mut r = rng(seed);
     let phys = Physical {
         m_kg: 1.46,
@@ -642,27 +653,17 @@ fn quantised_decay_run(dir: &Path, seed: u64, id: &str, cpr: u32, unit: &str) ->
         mu: 0.005,
         ..Physical::default()
     };
-    let w0 = phys.omega0_rad_s();
     let theta0: f64 = r.random_range(0.8..1.5);
     let duration_s = 50.0;
-    let model = Model::new(phys.to_dimensionless());
-    let tr = pendulum_model::sim::simulate(
-        &model,
-        &SimOptions::default(),
-        [theta0, 0.0],
-        0.0,
-        duration_s * w0,
-        w0 / 200.0,
-    )
-    .unwrap();
+    let (ts, thetas) = free_decay(&phys, theta0, duration_s);
     let mut csv = String::from("t_s,angle\n");
-    for (tau, th) in tr.t.iter().zip(&tr.theta) {
+    for (t_s, th) in ts.iter().zip(&thetas) {
         let count = (th * f64::from(cpr) / std::f64::consts::TAU).floor();
         let value = match unit {
             "counts" => format!("{count}"),
             _ => format!("{:.2}", count * 360.0 / f64::from(cpr)),
         };
-        csv.push_str(&format!("{:.6},{value}\n", tau / w0));
+        csv.push_str(&format!("{t_s:.6},{value}\n"));
     }
     let file = format!("{id}.csv");
     std::fs::write(dir.join(&file), csv).unwrap();
