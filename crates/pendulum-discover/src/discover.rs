@@ -439,8 +439,9 @@ pub const AGREEMENT_REL: f64 = 0.10;
 /// effect: the same sign, and each estimate inside the other's interval. The refit's value is
 /// inside the screen's when it lies within the screen's 95 % interval or within
 /// [`AGREEMENT_REL`] of its estimate, whichever is wider (10 % is the accuracy claimed for any
-/// estimate); the screen's value is inside the refit's when, put in the refit's place,
-/// it does not make the identify runs' trajectories significantly worse
+/// estimate); the screen's value is inside the refit's when the profile through it (the other
+/// parameters refitted with the effect's held at the screen's value) does not make the identify
+/// runs' trajectories significantly worse than the refit
 /// (`screen_fits_trajectories`, a paired test on their 0.5 s segments: trajectories often pin a
 /// dry torque's size poorly, trading it against μ). Two views that disagree on the sign have
 /// not found the effect: a 16 µs "accelerometer lag" the refit put at −47 µs was one.
@@ -731,8 +732,12 @@ fn speed_drift_row(
     let gain_needed = cfg.gain_min.max(noise);
     let refit_est = x.last().copied().unwrap_or(f64::NAN);
     row.refit_estimate = refit_est;
+    // The track's value is inside the trajectories' interval when the profile through it (the
+    // damping refitted with the drift held there) is not significantly worse than the refit.
     let screen_fits = {
-        let (g, n) = trajectory_substitution(&traj2, &spec, &x, &x0, &traj_ics2);
+        let i = spec.params.len() - 1;
+        let x_prof = refit_profile(&traj2, &spec, &x0, &traj_ics2, cfg.refit_evals, i);
+        let (g, n) = trajectory_substitution(&traj2, &spec, &x, &x_prof, &traj_ics2);
         g >= -n
     };
     row.accepted = gain > gain_needed && views_agree(est, half, refit_est, screen_fits);
@@ -875,21 +880,42 @@ fn moving_runs(runs: &[PreparedRun], ics: &[f64]) -> (Vec<PreparedRun>, Vec<f64>
     )
 }
 
-/// The damping/effect parameters alone, initial states held at the base fit's.
+/// The damping/effect parameters alone, initial states held at the base fit's; `fixed` holds one
+/// parameter (index, value) out of the search (a profile).
 struct ParamsOnly<'a> {
     inner: StudyObjective<'a>,
     ics: Vec<f64>,
+    fixed: Option<(usize, f64)>,
+}
+
+impl ParamsOnly<'_> {
+    /// The free parameters completed with the fixed one.
+    fn full(&self, x: &[f64]) -> Vec<f64> {
+        let mut full = x.to_vec();
+        if let Some((i, v)) = self.fixed {
+            full.insert(i, v);
+        }
+        full
+    }
 }
 
 impl Problem for ParamsOnly<'_> {
     fn dim(&self) -> usize {
-        self.inner.spec.params.len()
+        self.inner.spec.params.len() - usize::from(self.fixed.is_some())
     }
     fn bounds(&self) -> Vec<(f64, f64)> {
-        self.inner.spec.params.iter().map(|p| p.bounds()).collect()
+        let skip = self.fixed.map(|f| f.0);
+        self.inner
+            .spec
+            .params
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| Some(*i) != skip)
+            .map(|(_, p)| p.bounds())
+            .collect()
     }
     fn cost(&self, x: &[f64], bound: f64) -> Cost {
-        let mut full = x.to_vec();
+        let mut full = self.full(x);
         full.extend_from_slice(&self.ics);
         self.inner.cost(&full, bound)
     }
@@ -922,13 +948,41 @@ fn refit(
     ics: &[f64],
     evals: usize,
 ) -> (Vec<f64>, f64) {
+    refit_with(runs, spec, x0, ics, evals, None)
+}
+
+/// [`refit`] with parameter `i` held at `x0[i]`: the trajectories' best with that value (the
+/// profile through it). Returns the full parameter vector.
+fn refit_profile(
+    runs: &[PreparedRun],
+    spec: &ModelSpec,
+    x0: &[f64],
+    ics: &[f64],
+    evals: usize,
+    i: usize,
+) -> Vec<f64> {
+    refit_with(runs, spec, x0, ics, evals, Some((i, x0[i]))).0
+}
+
+fn refit_with(
+    runs: &[PreparedRun],
+    spec: &ModelSpec,
+    x0: &[f64],
+    ics: &[f64],
+    evals: usize,
+    fixed: Option<(usize, f64)>,
+) -> (Vec<f64>, f64) {
     let problem = ParamsOnly {
         inner: refit_objective(runs, spec),
         ics: ics.to_vec(),
+        fixed,
     };
     let bounds = problem.bounds();
     let x0: Vec<f64> = x0
         .iter()
+        .enumerate()
+        .filter(|(i, _)| Some(*i) != fixed.map(|f| f.0))
+        .map(|(_, v)| *v)
         .zip(&bounds)
         .map(|(v, (lo, hi))| v.clamp(*lo, *hi))
         .collect();
@@ -938,7 +992,7 @@ fn refit(
         .map(|(v, (lo, hi))| (0.2 * v.abs()).max(0.01 * (hi - lo)))
         .collect();
     let (x, f, _) = pendulum_fit::nelder_mead(&problem, &x0, &step, evals, 1e-6);
-    (x, f)
+    (problem.full(&x), f)
 }
 
 fn e_total(v: &[RunFit]) -> f64 {
@@ -1279,7 +1333,23 @@ pub fn discover(
         // trajectories (paired 0.5 s segments) than the refit? Substituting the effect alone
         // would not do: the refit's other terms co-adapt to its value (μ to a dry torque).
         let screen_fits_trajectories = {
-            let (g, n) = trajectory_substitution(&traj_runs, &spec, &x, &x0, &traj_ics);
+            // The profile through the screen's value: the other parameters refitted with the
+            // effect's held at the screen's estimate.
+            let i = match c.effect.as_str() {
+                "bearing_load_base_accel" => spec.params.iter().position(|p| *p == FitParam::Mu),
+                _ => news
+                    .first()
+                    .and_then(|(p, _)| spec.params.iter().position(|q| q == p)),
+            };
+            let x_prof = match i {
+                Some(i) => {
+                    let mut start = x0.clone();
+                    start[i] = est;
+                    refit_profile(&traj_runs, &spec, &start, &traj_ics, cfg.refit_evals, i)
+                }
+                None => x0.clone(),
+            };
+            let (g, n) = trajectory_substitution(&traj_runs, &spec, &x, &x_prof, &traj_ics);
             g >= -n
         };
         let agree = views_agree(est, 1.96 * se, refit_est, screen_fits_trajectories);
