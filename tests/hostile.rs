@@ -956,3 +956,102 @@ fn regression_issue_13_a_misspelt_campaign_key_is_named() {
         c.warnings
     );
 }
+
+// ---- Issue 13, item 9: sizes the machine cannot hold are refused up front. ----
+
+/// Asserts a size refusal: exit 1 (not an allocation abort, 134), the error naming each of
+/// `names` (the option, its value, the limit) and saying what a unit costs, and nothing written
+/// under `root` besides `keep`.
+fn assert_too_large(o: &Output, names: &[&str], root: &Path, keep: &[&str]) {
+    let (stdout, stderr) = text(o);
+    assert_eq!(o.status.code(), Some(1), "{stdout}{stderr}");
+    for n in names.iter().chain(&["limit", "bytes"]) {
+        assert!(stderr.contains(n), "{n:?} in {stderr}");
+    }
+    assert_eq!(tree(root), keep, "{stderr}");
+}
+
+/// `simulate --t-end 1e9` (2·10¹⁰ samples at the default spacing) used to grow until the
+/// integrator's step cap, `--dt-out 1e-9` to abort on a 4 GB allocation, `identify --np 1e8`
+/// to abort on the population's allocation, a twin case with `forced_s = 1e9` on its sample
+/// instants': each is now refused before any work, naming the option, the value and the limit.
+#[test]
+fn regression_issue_13_sizes_are_bounded_up_front() {
+    let root = tempfile::tempdir().unwrap();
+    let sim = |args: &[&str]| {
+        pendulum()
+            .arg("simulate")
+            .args(args)
+            .arg("--out")
+            .arg(root.path().join("sim.parquet"))
+            .output()
+            .unwrap()
+    };
+    assert_too_large(
+        &sim(&["--t-end", "1e9"]),
+        &["--t-end 1000000000", "--dt-out 0.05", "20000000"],
+        root.path(),
+        &[],
+    );
+    assert_too_large(
+        &sim(&["--dt-out", "1e-9"]),
+        &["--dt-out 0.000000001", "3.000e11", "20000000"],
+        root.path(),
+        &[],
+    );
+    // The default still runs, and a long one within the limit.
+    let o = sim(&["--t-end", "2000", "--dt-out", "0.5"]);
+    assert!(o.status.success(), "{:?}", text(&o));
+
+    let camp = campaign(
+        &root.path().join("c"),
+        "[[run]]\nid = \"r01\"\nfile = \"r01.csv\"\nrole = \"identify\"\n",
+    );
+    let o = pendulum()
+        .arg("identify")
+        .arg(&camp)
+        .arg("--out")
+        .arg(root.path().join("id"))
+        .args(["--np", "100000000", "--generations", "1", "--quiet"])
+        .output()
+        .unwrap();
+    assert_too_large(
+        &o,
+        &["--np 100000000", "100000"],
+        root.path(),
+        &["c/camp/campaign.toml", "c/camp/r01.csv", "sim.parquet"],
+    );
+
+    let case = root.path().join("case.toml");
+    std::fs::write(
+        &case,
+        "name = \"long\"\nseed = 1\n[rig]\nm_kg = 1.46\nl_m = 0.265\ncrank_r_m = 0.0725\n\
+         rod_L_m = 0.575\nr_b_m = 0.01225\n[truth]\nb_n_s_m = 0.5\nmu = 0.15\n\
+         [[run]]\nid = \"long\"\nomega_hz = 1.54\nrole = \"identify\"\nformat = \"sd\"\n\
+         theta0_rad = 0.5\nfree_s = 2\nforced_s = 1e9\n",
+    )
+    .unwrap();
+    let o = pendulum()
+        .arg("synth")
+        .arg(&case)
+        .arg(root.path().join("twin"))
+        .output()
+        .unwrap();
+    assert_too_large(
+        &o,
+        &[
+            "case.toml",
+            "run `long`",
+            "forced_s",
+            "1000000000",
+            "14400 s",
+        ],
+        root.path(),
+        &[
+            "c/camp/campaign.toml",
+            "c/camp/r01.csv",
+            "case.toml",
+            "sim.parquet",
+        ],
+    );
+}

@@ -51,6 +51,16 @@ pub enum JobError {
         input: PathBuf,
         what_input: String,
     },
+    /// A size the machine cannot hold, refused before any work: `given` names the options and
+    /// their values, `what` counts what they ask for, `why` says what each unit costs and what
+    /// the limit comes to.
+    #[error("{given} asks for {what}, more than the limit of {limit}: {why}")]
+    TooLarge {
+        given: String,
+        what: String,
+        limit: String,
+        why: String,
+    },
     #[error("{0}")]
     Invalid(String),
 }
