@@ -1055,3 +1055,105 @@ fn regression_issue_13_sizes_are_bounded_up_front() {
         ],
     );
 }
+
+// ---- Issue 13, item 6: an output folder is one unit. ----
+
+/// `invocation_id` of every Parquet table directly in `dir`, by file name.
+fn invocation_ids(dir: &Path) -> BTreeMap<String, String> {
+    let mut ids = BTreeMap::new();
+    for e in std::fs::read_dir(dir).unwrap() {
+        let p = e.unwrap().path();
+        if p.extension().is_none_or(|x| x != "parquet") {
+            continue;
+        }
+        let file = std::fs::File::open(&p).unwrap();
+        let r = parquet::file::reader::SerializedFileReader::new(file).unwrap();
+        let kv = parquet::file::reader::FileReader::metadata(&r)
+            .file_metadata()
+            .key_value_metadata()
+            .cloned()
+            .unwrap_or_default();
+        let id = kv
+            .iter()
+            .find(|k| k.key == "invocation_id")
+            .and_then(|k| k.value.clone())
+            .unwrap_or_else(|| panic!("{}: no invocation_id in {kv:?}", p.display()));
+        ids.insert(p.file_name().unwrap().to_string_lossy().into_owned(), id);
+    }
+    ids
+}
+
+/// Script 07: `identify` killed over an earlier result left new tables beside stale ones with
+/// nothing to tell them apart, and temporary files (PID-named) for good. Now every table of one
+/// invocation carries one `invocation_id` (another invocation's differ), and a command writing
+/// into OUT removes this program's temporary files there that are older than its start and
+/// whose writer no longer runs, and nothing else: not a running writer's, not a fresh one, not
+/// a user's own dot-file.
+#[test]
+fn regression_issue_13_tables_carry_one_invocation_id_and_stale_temps_go() {
+    let root = tempfile::tempdir().unwrap();
+    let (mc, idr) = identified_campaign(&root.path().join("twin"));
+    let first = invocation_ids(&idr);
+    assert!(first.len() >= 5, "{first:?}");
+    let a = first.values().next().unwrap().clone();
+    assert!(first.values().all(|v| *v == a), "{first:?}");
+
+    // A process that has ended, and one that runs (this test).
+    let mut done = std::process::Command::new("true").spawn().unwrap();
+    let dead = done.id();
+    done.wait().unwrap();
+    let own = std::process::id();
+    let hour = std::time::Duration::from_secs(3600);
+    let seed = |name: &str, modified: std::time::SystemTime| {
+        let p = idr.join(name);
+        std::fs::write(&p, "left behind").unwrap();
+        let f = std::fs::File::options().write(true).open(&p).unwrap();
+        f.set_modified(modified).unwrap();
+    };
+    let now = std::time::SystemTime::now();
+    let stale = [
+        format!(".residuals.parquet.{dead}-3.tmp"),
+        format!(".history_reference_r01.png.{dead}-0.tmp.png"),
+    ];
+    let kept = [
+        format!(".runs.parquet.{own}-0.tmp"),    // its writer still runs
+        format!(".params.parquet.{dead}-9.tmp"), // newer than the command's start
+        ".notes.txt".to_string(),                // not this program's
+        format!(".r01.mcap.{dead}.tmp"),         // not this program's pattern
+    ];
+    for n in &stale {
+        seed(n, now - hour);
+    }
+    for (i, n) in kept.iter().enumerate() {
+        seed(n, if i == 1 { now + hour } else { now - hour });
+    }
+
+    let o = pendulum()
+        .arg("identify")
+        .arg(&mc)
+        .arg("--out")
+        .arg(&idr)
+        .args(["--np", "10", "--generations", "2", "--seed", "5", "--quiet"])
+        .output()
+        .unwrap();
+    let (stdout, stderr) = text(&o);
+    assert!(o.status.success(), "{stdout}{stderr}");
+    assert!(
+        stdout.contains("removed 2 temporary file(s)") && stdout.contains(&stale[0]),
+        "{stdout}"
+    );
+    for n in &stale {
+        assert!(!idr.join(n).exists(), "{n} left");
+    }
+    for n in &kept {
+        assert!(idr.join(n).exists(), "{n} removed");
+    }
+    let second = invocation_ids(&idr);
+    assert_eq!(
+        second.keys().collect::<Vec<_>>(),
+        first.keys().collect::<Vec<_>>()
+    );
+    let b = second.values().next().unwrap().clone();
+    assert!(second.values().all(|v| *v == b), "{second:?}");
+    assert_ne!(a, b, "two invocations share an id");
+}

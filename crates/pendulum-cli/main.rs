@@ -210,6 +210,8 @@ struct DemoArgs {
 }
 
 fn main() -> ExitCode {
+    // Fixes the invocation's id and start now: temporary files in OUT older than it are not ours.
+    pendulum_jobs::invocation();
     let cli = Cli::parse();
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,

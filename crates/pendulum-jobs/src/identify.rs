@@ -14,7 +14,7 @@ use pendulum_process::pipeline::{Context, PipelineConfig, StageConfig};
 use pendulum_process::{Role, RunData};
 
 use crate::inputs::Inputs;
-use crate::outputs::{write_outputs_checked, OutputSummary, TABLES};
+use crate::outputs::{prepare_out_dir, removed_note, write_outputs_checked, OutputSummary, TABLES};
 use crate::runs::load_runs;
 use crate::JobError;
 
@@ -204,6 +204,7 @@ pub fn run(job: &IdentifyJob) -> Result<OutputSummary, JobError> {
         inputs.add("--pipeline", p);
     }
     let inputs = checked_inputs(inputs, &job.input, &job.out)?;
+    let removed = prepare_out_dir(&job.out)?;
     let runs: Vec<RunData> = load_runs(&job.input)?;
     if !runs.iter().any(|r| r.role == Role::Identify) {
         return Err(JobError::Invalid(format!(
@@ -212,6 +213,7 @@ pub fn run(job: &IdentifyJob) -> Result<OutputSummary, JobError> {
         )));
     }
     let mut ctx = Context::new(runs);
+    ctx.notes.extend(removed_note(&removed));
     // The fit silently runs with at least MIN_NP members: say so, naming where np came from.
     if let Some(np) = pipeline
         .fit_mut()
@@ -324,6 +326,7 @@ pub fn validate(job: &ValidateJob) -> Result<OutputSummary, JobError> {
         inputs.add("--pipeline", p);
     }
     let inputs = checked_inputs(inputs, &job.input, &job.out)?;
+    let removed = prepare_out_dir(&job.out)?;
     let runs = load_runs(&job.input)?;
     if !runs.iter().any(|r| r.role == Role::Validate) {
         return Err(JobError::Invalid(format!(
@@ -332,6 +335,7 @@ pub fn validate(job: &ValidateJob) -> Result<OutputSummary, JobError> {
         )));
     }
     let mut ctx = Context::new(runs);
+    ctx.notes.extend(removed_note(&removed));
     ctx.given = Some(given);
     pipeline.run(&mut ctx)?;
     write_outputs_checked(

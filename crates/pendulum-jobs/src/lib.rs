@@ -17,6 +17,10 @@ pub mod zones;
 
 use std::path::PathBuf;
 
+/// This process's invocation (id carried by every table, start instant): the binary calls it
+/// first thing so that the start is the process's.
+pub use pendulum_report::invocation;
+
 /// Errors of a job, with the layer that failed.
 #[derive(Debug, thiserror::Error)]
 pub enum JobError {
