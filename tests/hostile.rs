@@ -1157,3 +1157,48 @@ fn regression_issue_13_tables_carry_one_invocation_id_and_stale_temps_go() {
     assert!(second.values().all(|v| *v == b), "{second:?}");
     assert_ne!(a, b, "two invocations share an id");
 }
+
+// ---- Issue 13, item 10: messages. ----
+
+/// An OUT that cannot be written is found before the runs are loaded and fitted, not after the
+/// fit: with a campaign that has no identify run, the OUT error comes first (before the fix,
+/// OUT was first created when the tables were written, after the fit). The cause of an error
+/// naming a file is said once: it used to read "Not a directory (os error 20)" twice, once in
+/// the message and again as "caused by".
+#[test]
+fn regression_issue_13_out_checked_before_the_fit_and_causes_said_once() {
+    let root = tempfile::tempdir().unwrap();
+    let camp = campaign(
+        root.path(),
+        "[[run]]\nid = \"r01\"\nfile = \"r01.csv\"\nrole = \"validate\"\n",
+    );
+    let file = root.path().join("a_file");
+    std::fs::write(&file, "not a folder").unwrap();
+    let out = file.join("out");
+    let o = pendulum()
+        .arg("identify")
+        .arg(&camp)
+        .arg("--out")
+        .arg(&out)
+        .args(["--generations", "1", "--quiet"])
+        .output()
+        .unwrap();
+    let (stdout, stderr) = text(&o);
+    assert_eq!(o.status.code(), Some(1), "{stdout}{stderr}");
+    assert!(
+        stderr.contains(&format!("{}: Not a directory", out.display()))
+            && !stderr.contains("no run has role"),
+        "{stderr}"
+    );
+    assert_eq!(stderr.matches("Not a directory").count(), 1, "{stderr}");
+
+    let o = pendulum()
+        .arg("simulate")
+        .arg("--out")
+        .arg(file.join("s.parquet"))
+        .output()
+        .unwrap();
+    let (stdout, stderr) = text(&o);
+    assert_eq!(o.status.code(), Some(1), "{stdout}{stderr}");
+    assert_eq!(stderr.matches("Not a directory").count(), 1, "{stderr}");
+}
