@@ -956,3 +956,249 @@ fn regression_issue_13_a_misspelt_campaign_key_is_named() {
         c.warnings
     );
 }
+
+// ---- Issue 13, item 9: sizes the machine cannot hold are refused up front. ----
+
+/// Asserts a size refusal: exit 1 (not an allocation abort, 134), the error naming each of
+/// `names` (the option, its value, the limit) and saying what a unit costs, and nothing written
+/// under `root` besides `keep`.
+fn assert_too_large(o: &Output, names: &[&str], root: &Path, keep: &[&str]) {
+    let (stdout, stderr) = text(o);
+    assert_eq!(o.status.code(), Some(1), "{stdout}{stderr}");
+    for n in names.iter().chain(&["limit", "bytes"]) {
+        assert!(stderr.contains(n), "{n:?} in {stderr}");
+    }
+    assert_eq!(tree(root), keep, "{stderr}");
+}
+
+/// `simulate --t-end 1e9` (2·10¹⁰ samples at the default spacing) used to grow until the
+/// integrator's step cap, `--dt-out 1e-9` to abort on a 4 GB allocation, `identify --np 1e8`
+/// to abort on the population's allocation, a twin case with `forced_s = 1e9` on its sample
+/// instants': each is now refused before any work, naming the option, the value and the limit.
+#[test]
+fn regression_issue_13_sizes_are_bounded_up_front() {
+    let root = tempfile::tempdir().unwrap();
+    let sim = |args: &[&str]| {
+        pendulum()
+            .arg("simulate")
+            .args(args)
+            .arg("--out")
+            .arg(root.path().join("sim.parquet"))
+            .output()
+            .unwrap()
+    };
+    assert_too_large(
+        &sim(&["--t-end", "1e9"]),
+        &["--t-end 1000000000", "--dt-out 0.05", "20000000"],
+        root.path(),
+        &[],
+    );
+    assert_too_large(
+        &sim(&["--dt-out", "1e-9"]),
+        &["--dt-out 0.000000001", "3.000e11", "20000000"],
+        root.path(),
+        &[],
+    );
+    // The default still runs, and a long one within the limit.
+    let o = sim(&["--t-end", "2000", "--dt-out", "0.5"]);
+    assert!(o.status.success(), "{:?}", text(&o));
+
+    let camp = campaign(
+        &root.path().join("c"),
+        "[[run]]\nid = \"r01\"\nfile = \"r01.csv\"\nrole = \"identify\"\n",
+    );
+    let o = pendulum()
+        .arg("identify")
+        .arg(&camp)
+        .arg("--out")
+        .arg(root.path().join("id"))
+        .args(["--np", "100000000", "--generations", "1", "--quiet"])
+        .output()
+        .unwrap();
+    assert_too_large(
+        &o,
+        &["--np 100000000", "100000"],
+        root.path(),
+        &["c/camp/campaign.toml", "c/camp/r01.csv", "sim.parquet"],
+    );
+
+    let case = root.path().join("case.toml");
+    std::fs::write(
+        &case,
+        "name = \"long\"\nseed = 1\n[rig]\nm_kg = 1.46\nl_m = 0.265\ncrank_r_m = 0.0725\n\
+         rod_L_m = 0.575\nr_b_m = 0.01225\n[truth]\nb_n_s_m = 0.5\nmu = 0.15\n\
+         [[run]]\nid = \"long\"\nomega_hz = 1.54\nrole = \"identify\"\nformat = \"sd\"\n\
+         theta0_rad = 0.5\nfree_s = 2\nforced_s = 1e9\n",
+    )
+    .unwrap();
+    let o = pendulum()
+        .arg("synth")
+        .arg(&case)
+        .arg(root.path().join("twin"))
+        .output()
+        .unwrap();
+    assert_too_large(
+        &o,
+        &[
+            "case.toml",
+            "run `long`",
+            "forced_s",
+            "1000000000",
+            "14400 s",
+        ],
+        root.path(),
+        &[
+            "c/camp/campaign.toml",
+            "c/camp/r01.csv",
+            "case.toml",
+            "sim.parquet",
+        ],
+    );
+}
+
+// ---- Issue 13, item 6: an output folder is one unit. ----
+
+/// `invocation_id` of every Parquet table directly in `dir`, by file name.
+fn invocation_ids(dir: &Path) -> BTreeMap<String, String> {
+    let mut ids = BTreeMap::new();
+    for e in std::fs::read_dir(dir).unwrap() {
+        let p = e.unwrap().path();
+        if p.extension().is_none_or(|x| x != "parquet") {
+            continue;
+        }
+        let file = std::fs::File::open(&p).unwrap();
+        let r = parquet::file::reader::SerializedFileReader::new(file).unwrap();
+        let kv = parquet::file::reader::FileReader::metadata(&r)
+            .file_metadata()
+            .key_value_metadata()
+            .cloned()
+            .unwrap_or_default();
+        let id = kv
+            .iter()
+            .find(|k| k.key == "invocation_id")
+            .and_then(|k| k.value.clone())
+            .unwrap_or_else(|| panic!("{}: no invocation_id in {kv:?}", p.display()));
+        ids.insert(p.file_name().unwrap().to_string_lossy().into_owned(), id);
+    }
+    ids
+}
+
+/// Script 07: `identify` killed over an earlier result left new tables beside stale ones with
+/// nothing to tell them apart, and temporary files (PID-named) for good. Now every table of one
+/// invocation carries one `invocation_id` (another invocation's differ), and a command writing
+/// into OUT removes this program's temporary files there that are older than its start and
+/// whose writer no longer runs, and nothing else: not a running writer's, not a fresh one, not
+/// a user's own dot-file.
+#[test]
+fn regression_issue_13_tables_carry_one_invocation_id_and_stale_temps_go() {
+    let root = tempfile::tempdir().unwrap();
+    let (mc, idr) = identified_campaign(&root.path().join("twin"));
+    let first = invocation_ids(&idr);
+    assert!(first.len() >= 5, "{first:?}");
+    let a = first.values().next().unwrap().clone();
+    assert!(first.values().all(|v| *v == a), "{first:?}");
+
+    // A process that has ended, and one that runs (this test).
+    let mut done = std::process::Command::new("true").spawn().unwrap();
+    let dead = done.id();
+    done.wait().unwrap();
+    let own = std::process::id();
+    let hour = std::time::Duration::from_secs(3600);
+    let seed = |name: &str, modified: std::time::SystemTime| {
+        let p = idr.join(name);
+        std::fs::write(&p, "left behind").unwrap();
+        let f = std::fs::File::options().write(true).open(&p).unwrap();
+        f.set_modified(modified).unwrap();
+    };
+    let now = std::time::SystemTime::now();
+    let stale = [
+        format!(".residuals.parquet.{dead}-3.tmp"),
+        format!(".history_reference_r01.png.{dead}-0.tmp.png"),
+    ];
+    let kept = [
+        format!(".runs.parquet.{own}-0.tmp"),    // its writer still runs
+        format!(".params.parquet.{dead}-9.tmp"), // newer than the command's start
+        ".notes.txt".to_string(),                // not this program's
+        format!(".r01.mcap.{dead}.tmp"),         // not this program's pattern
+    ];
+    for n in &stale {
+        seed(n, now - hour);
+    }
+    for (i, n) in kept.iter().enumerate() {
+        seed(n, if i == 1 { now + hour } else { now - hour });
+    }
+
+    let o = pendulum()
+        .arg("identify")
+        .arg(&mc)
+        .arg("--out")
+        .arg(&idr)
+        .args(["--np", "10", "--generations", "2", "--seed", "5", "--quiet"])
+        .output()
+        .unwrap();
+    let (stdout, stderr) = text(&o);
+    assert!(o.status.success(), "{stdout}{stderr}");
+    assert!(
+        stdout.contains("removed 2 temporary file(s)") && stdout.contains(&stale[0]),
+        "{stdout}"
+    );
+    for n in &stale {
+        assert!(!idr.join(n).exists(), "{n} left");
+    }
+    for n in &kept {
+        assert!(idr.join(n).exists(), "{n} removed");
+    }
+    let second = invocation_ids(&idr);
+    assert_eq!(
+        second.keys().collect::<Vec<_>>(),
+        first.keys().collect::<Vec<_>>()
+    );
+    let b = second.values().next().unwrap().clone();
+    assert!(second.values().all(|v| *v == b), "{second:?}");
+    assert_ne!(a, b, "two invocations share an id");
+}
+
+// ---- Issue 13, item 10: messages. ----
+
+/// An OUT that cannot be written is found before the runs are loaded and fitted, not after the
+/// fit: with a campaign that has no identify run, the OUT error comes first (before the fix,
+/// OUT was first created when the tables were written, after the fit). The cause of an error
+/// naming a file is said once: it used to read "Not a directory (os error 20)" twice, once in
+/// the message and again as "caused by".
+#[test]
+fn regression_issue_13_out_checked_before_the_fit_and_causes_said_once() {
+    let root = tempfile::tempdir().unwrap();
+    let camp = campaign(
+        root.path(),
+        "[[run]]\nid = \"r01\"\nfile = \"r01.csv\"\nrole = \"validate\"\n",
+    );
+    let file = root.path().join("a_file");
+    std::fs::write(&file, "not a folder").unwrap();
+    let out = file.join("out");
+    let o = pendulum()
+        .arg("identify")
+        .arg(&camp)
+        .arg("--out")
+        .arg(&out)
+        .args(["--generations", "1", "--quiet"])
+        .output()
+        .unwrap();
+    let (stdout, stderr) = text(&o);
+    assert_eq!(o.status.code(), Some(1), "{stdout}{stderr}");
+    assert!(
+        stderr.contains(&format!("{}: Not a directory", out.display()))
+            && !stderr.contains("no run has role"),
+        "{stderr}"
+    );
+    assert_eq!(stderr.matches("Not a directory").count(), 1, "{stderr}");
+
+    let o = pendulum()
+        .arg("simulate")
+        .arg("--out")
+        .arg(file.join("s.parquet"))
+        .output()
+        .unwrap();
+    let (stdout, stderr) = text(&o);
+    assert_eq!(o.status.code(), Some(1), "{stdout}{stderr}");
+    assert_eq!(stderr.matches("Not a directory").count(), 1, "{stderr}");
+}

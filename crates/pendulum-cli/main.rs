@@ -210,13 +210,22 @@ struct DemoArgs {
 }
 
 fn main() -> ExitCode {
+    // Fixes the invocation's id and start now: temporary files in OUT older than it are not ours.
+    pendulum_jobs::invocation();
     let cli = Cli::parse();
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e}");
+            // Errors that name a file say `{path}: {source}` and keep the source in the chain:
+            // a cause already said above is not printed again (it read "Not a directory" twice).
+            let mut said = e.to_string();
+            eprintln!("error: {said}");
             for cause in e.chain().skip(1) {
-                eprintln!("  caused by: {cause}");
+                let cause = cause.to_string();
+                if !said.contains(&cause) {
+                    eprintln!("  caused by: {cause}");
+                    said.push_str(&cause);
+                }
             }
             ExitCode::FAILURE
         }

@@ -254,11 +254,10 @@ pub(crate) fn progress_bar(total: u64, what: &str, show: bool) -> ProgressBar {
     b
 }
 
+/// Creates OUT, checks it is writable and sweeps this program's stale temporary files from it
+/// ([`crate::outputs::prepare_out_dir`]).
 pub(crate) fn create_dir(dir: &Path) -> Result<(), JobError> {
-    std::fs::create_dir_all(dir).map_err(|source| JobError::Io {
-        path: dir.to_path_buf(),
-        source,
-    })
+    crate::outputs::prepare_out_dir(dir).map(drop)
 }
 
 /// `pendulum bifurcate` options.

@@ -154,6 +154,8 @@ pub fn run(job: &DiscoverJob) -> Result<DiscoverSummary, JobError> {
             .cloned()
             .collect(),
     };
+    // OUT checked writable (and swept of stale temporary files) before the fits, not after.
+    let removed = crate::outputs::prepare_out_dir(&job.out)?;
     let (runs, steps): (Vec<_>, Vec<_>) = load_runs_resolved(&job.input)?.into_iter().unzip();
     if !runs.is_empty() && runs.iter().all(|r| r.rig.omega_hz.is_none()) {
         return free_decays(job, &runs, &steps, &pipeline_json);
@@ -168,6 +170,7 @@ pub fn run(job: &DiscoverJob) -> Result<DiscoverSummary, JobError> {
         }
     }
     let mut ctx = Context::new(runs);
+    ctx.notes.extend(crate::outputs::removed_note(&removed));
     let max_gen = stages.stages.iter().find_map(|s| match s {
         StageConfig::Fit(f) => Some(f.max_generations),
         _ => None,

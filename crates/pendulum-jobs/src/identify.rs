@@ -7,12 +7,14 @@ use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressStyle};
 use pendulum_fit::StopRule;
-use pendulum_process::identify::{residual_series, FitOutcome, ResidualSeries, RunFit, MIN_NP};
+use pendulum_process::identify::{
+    residual_series, FitOutcome, ResidualSeries, RunFit, MAX_NP, MIN_NP,
+};
 use pendulum_process::pipeline::{Context, PipelineConfig, StageConfig};
 use pendulum_process::{Role, RunData};
 
 use crate::inputs::Inputs;
-use crate::outputs::{write_outputs_checked, OutputSummary, TABLES};
+use crate::outputs::{prepare_out_dir, removed_note, write_outputs_checked, OutputSummary, TABLES};
 use crate::runs::load_runs;
 use crate::JobError;
 
@@ -195,12 +197,14 @@ pub fn run(job: &IdentifyJob) -> Result<OutputSummary, JobError> {
     let started = Instant::now();
     let (mut pipeline, _) = load_pipeline(job.pipeline.as_deref(), IDENTIFY_PIPELINE, "identify")?;
     apply_overrides(&mut pipeline, &job.overrides);
+    check_np(&mut pipeline, job)?;
     let pipeline_text = serde_json::to_string(&pipeline).unwrap_or_default();
     let mut inputs = Inputs::new();
     if let Some(p) = &job.pipeline {
         inputs.add("--pipeline", p);
     }
     let inputs = checked_inputs(inputs, &job.input, &job.out)?;
+    let removed = prepare_out_dir(&job.out)?;
     let runs: Vec<RunData> = load_runs(&job.input)?;
     if !runs.iter().any(|r| r.role == Role::Identify) {
         return Err(JobError::Invalid(format!(
@@ -209,6 +213,7 @@ pub fn run(job: &IdentifyJob) -> Result<OutputSummary, JobError> {
         )));
     }
     let mut ctx = Context::new(runs);
+    ctx.notes.extend(removed_note(&removed));
     // The fit silently runs with at least MIN_NP members: say so, naming where np came from.
     if let Some(np) = pipeline
         .fit_mut()
@@ -273,6 +278,32 @@ pub fn run(job: &IdentifyJob) -> Result<OutputSummary, JobError> {
     Ok(summary)
 }
 
+/// Refuses a population the machine cannot hold before the runs are loaded (see [`MAX_NP`]),
+/// naming where it came from: `--np 100000000` used to abort on allocation (exit 134).
+fn check_np(pipeline: &mut PipelineConfig, job: &IdentifyJob) -> Result<(), JobError> {
+    let Some(np) = pipeline
+        .fit_mut()
+        .and_then(|f| f.np)
+        .filter(|&n| n > MAX_NP)
+    else {
+        return Ok(());
+    };
+    let given = match (&job.overrides.np, &job.pipeline) {
+        (Some(_), _) => format!("--np {np}"),
+        (None, Some(p)) => format!("{}: np = {np}", p.display()),
+        (None, None) => format!("the built-in pipeline's np = {np}"),
+    };
+    Err(JobError::TooLarge {
+        given,
+        what: "as many DE population members".into(),
+        limit: MAX_NP.to_string(),
+        why: "DE holds the population and a generation of trials, each a vector of 3 + 2·runs \
+              numbers (8 bytes each): 1.6 GB at the limit with 500 runs, and every member \
+              simulates every run each generation; the default is 10 · (3 + 2·runs)"
+            .into(),
+    })
+}
+
 /// What to validate: fixed parameters from a params.parquet.
 #[derive(Debug, Clone)]
 pub struct ValidateJob {
@@ -295,6 +326,7 @@ pub fn validate(job: &ValidateJob) -> Result<OutputSummary, JobError> {
         inputs.add("--pipeline", p);
     }
     let inputs = checked_inputs(inputs, &job.input, &job.out)?;
+    let removed = prepare_out_dir(&job.out)?;
     let runs = load_runs(&job.input)?;
     if !runs.iter().any(|r| r.role == Role::Validate) {
         return Err(JobError::Invalid(format!(
@@ -303,6 +335,7 @@ pub fn validate(job: &ValidateJob) -> Result<OutputSummary, JobError> {
         )));
     }
     let mut ctx = Context::new(runs);
+    ctx.notes.extend(removed_note(&removed));
     ctx.given = Some(given);
     pipeline.run(&mut ctx)?;
     write_outputs_checked(

@@ -287,10 +287,7 @@ pub fn run(dir: &Path, out_dir: &Path, show_progress: bool) -> Result<IngestSumm
             &mcap_path(out_dir, spec),
         )?;
     }
-    std::fs::create_dir_all(out_dir).map_err(|source| JobError::Io {
-        path: out_dir.to_path_buf(),
-        source,
-    })?;
+    crate::outputs::prepare_out_dir(out_dir)?;
     let bar = if show_progress {
         let b = ProgressBar::new(c.runs.len() as u64);
         b.set_style(

@@ -17,6 +17,10 @@ pub mod zones;
 
 use std::path::PathBuf;
 
+/// This process's invocation (id carried by every table, start instant): the binary calls it
+/// first thing so that the start is the process's.
+pub use pendulum_report::invocation;
+
 /// Errors of a job, with the layer that failed.
 #[derive(Debug, thiserror::Error)]
 pub enum JobError {
@@ -50,6 +54,16 @@ pub enum JobError {
         what_output: String,
         input: PathBuf,
         what_input: String,
+    },
+    /// A size the machine cannot hold, refused before any work: `given` names the options and
+    /// their values, `what` counts what they ask for, `why` says what each unit costs and what
+    /// the limit comes to.
+    #[error("{given} asks for {what}, more than the limit of {limit}: {why}")]
+    TooLarge {
+        given: String,
+        what: String,
+        limit: String,
+        why: String,
     },
     #[error("{0}")]
     Invalid(String),

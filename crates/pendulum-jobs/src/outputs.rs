@@ -49,6 +49,75 @@ const ALL_EFFECT_PARAMS: [FitParam; 8] = [
     FitParam::EncoderOffset,
 ];
 
+/// Makes OUT ready for a command that writes there, before its long work: creates it, proves it
+/// writable (a probe file created and removed: an unwritable OUT used to fail only after the
+/// fit), and removes this program's stale temporary files from it ([`remove_stale_temps`]).
+/// Returns the files removed.
+pub fn prepare_out_dir(out: &Path) -> Result<Vec<PathBuf>, JobError> {
+    let io = |path: &Path| {
+        let path = path.to_path_buf();
+        move |source| JobError::Io { path, source }
+    };
+    std::fs::create_dir_all(out).map_err(io(out))?;
+    // Named like a writer's temporary file, so that a crash between these two lines leaves a
+    // file the next sweep removes.
+    let probe = out.join(format!(".write-check.{}-0.tmp", std::process::id()));
+    std::fs::File::create_new(&probe).map_err(io(out))?;
+    std::fs::remove_file(&probe).map_err(io(&probe))?;
+    remove_stale_temps(out)
+}
+
+/// Removes from `dir` (not its subfolders) this program's temporary files
+/// ([`pendulum_report::temp_writer_pid`]) left by an earlier, interrupted process: last modified
+/// before this process started, of another process id, and (where `/proc` shows which processes
+/// run) of a process no longer running, so that a concurrent writer's file is never taken. A
+/// killed `identify` used to leave them for good (up to 116 MB each).
+pub fn remove_stale_temps(dir: &Path) -> Result<Vec<PathBuf>, JobError> {
+    let started = pendulum_report::invocation().started;
+    let own = std::process::id();
+    let proc_known = Path::new("/proc/self").exists();
+    let entries = std::fs::read_dir(dir).map_err(|source| JobError::Io {
+        path: dir.to_path_buf(),
+        source,
+    })?;
+    let mut removed = Vec::new();
+    for e in entries.flatten() {
+        let name = e.file_name().to_string_lossy().into_owned();
+        let Some(pid) = pendulum_report::temp_writer_pid(&name) else {
+            continue;
+        };
+        let Ok(md) = e.metadata() else { continue };
+        let old = md.modified().is_ok_and(|t| t < started);
+        let running = proc_known && Path::new(&format!("/proc/{pid}")).exists();
+        if md.is_file() && pid != own && old && !running {
+            let path = e.path();
+            std::fs::remove_file(&path).map_err(|source| JobError::Io {
+                path: path.clone(),
+                source,
+            })?;
+            removed.push(path);
+        }
+    }
+    removed.sort();
+    Ok(removed)
+}
+
+/// A note for a command's summary naming the stale temporary files removed from OUT.
+pub fn removed_note(removed: &[PathBuf]) -> Option<String> {
+    let names: Vec<String> = removed
+        .iter()
+        .filter_map(|p| p.file_name())
+        .map(|n| n.to_string_lossy().into_owned())
+        .collect();
+    (!names.is_empty()).then(|| {
+        format!(
+            "removed {} temporary file(s) an interrupted earlier run left in the output folder: {}",
+            names.len(),
+            names.join(", ")
+        )
+    })
+}
+
 fn meta(pipeline: &str, command: &str) -> TableOptions {
     TableOptions::new()
         .meta("command", command)

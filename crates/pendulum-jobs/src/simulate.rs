@@ -57,10 +57,39 @@ impl std::fmt::Display for SimulateSummary {
     }
 }
 
+/// The most output samples `simulate` writes. The trajectory holds t, θ, θ̇ (3 × 8 = 24 bytes a
+/// sample) in vectors that grow by doubling (up to 2× while growing), and the table is written
+/// from a copy of them plus Arrow's own buffers: about 4 × 24 ≈ 100 bytes a sample at the peak,
+/// so 20,000,000 samples ≈ 2 GB, a tenth of this 24 GB machine and within a laptop's. The
+/// default run (t = 300, dt_out = 0.05) writes 6,001.
+pub const MAX_SAMPLES: f64 = 20_000_000.0;
+
+/// Refuses a `t_end`/`dt_out` pair whose output would not fit in memory, before integrating:
+/// `--dt-out 1e-9` used to abort on a 4 GB allocation (exit 134), `--t-end 1e9` to grow until the
+/// integrator's step cap. Invalid values (non-positive, NaN) are left to the simulator's check.
+fn check_size(job: &SimulateJob) -> Result<(), JobError> {
+    if !(job.dt_out > 0.0) || !(job.t_end > 0.0) {
+        return Ok(());
+    }
+    let samples = (job.t_end / job.dt_out).floor() + 1.0;
+    if samples <= MAX_SAMPLES {
+        return Ok(());
+    }
+    Err(JobError::TooLarge {
+        given: format!("--t-end {} with --dt-out {}", job.t_end, job.dt_out),
+        what: format!("{samples:.3e} output samples"),
+        limit: format!("{MAX_SAMPLES:.0}"),
+        why: "each sample is t, θ, θ̇ (24 bytes), held about 4 times over while the table is \
+              written: 2 GB at the limit; raise --dt-out or lower --t-end"
+            .into(),
+    })
+}
+
 /// Poincaré points recorded for the class: the last `RECORD` forcing periods (or half the run).
 const RECORD: u32 = 50;
 
 pub fn run(job: &SimulateJob) -> Result<SimulateSummary, JobError> {
+    check_size(job)?;
     let spec = ParamSpec::parse(&job.params)?;
     let (physical, params) = spec.resolve(&Physical::default())?;
     let model = Model::new(params);

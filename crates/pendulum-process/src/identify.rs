@@ -241,6 +241,12 @@ impl FitConfig {
                 message,
             })
         };
+        if let Some(np) = self.np.filter(|&n| n > MAX_NP) {
+            return bad(
+                "np",
+                format!("{np} is more than the limit of {MAX_NP} (see MAX_NP)"),
+            );
+        }
         if !(self.window.window_s > 0.0) {
             return bad("window_s", format!("{} must be > 0", self.window.window_s));
         }
@@ -289,6 +295,14 @@ impl RunFit {
 /// The smallest DE population the fit runs with (differential evolution's mutation draws three
 /// members besides the target); a smaller `np` is raised to it.
 pub const MIN_NP: usize = 4;
+
+/// The largest DE population the fit accepts. DE holds the population and a generation of
+/// trials, each member a vector of the fit's dimension (3 + 2·runs): np × 2 × dim × 8 bytes, plus
+/// about 40 bytes of vector bookkeeping a member. At 100,000 members and 500 runs (dim 1,003)
+/// that is 100,000 × 2 × (1,003 × 8 + 40) ≈ 1.6 GB; `--np 1e8` asked for 100 times more than
+/// the machine holds and aborted on allocation (exit 134). The study's default is 10 · dim
+/// (170 for 7 runs), and every member costs one simulation of every run per generation.
+pub const MAX_NP: usize = 100_000;
 
 /// A fitted model.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -7,7 +7,8 @@ use std::collections::HashMap;
 use std::fs::File;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
+use std::time::{SystemTime, UNIX_EPOCH};
 
 use arrow_array::{ArrayRef, BooleanArray, Float64Array, Int64Array, RecordBatch, StringArray};
 use arrow_schema::{DataType, Field, Schema};
@@ -99,6 +100,37 @@ impl Column {
     }
 }
 
+/// One run of the program: an id every table it writes carries (key `invocation_id`), so that
+/// tables of different runs of a command left in one folder (one killed over an earlier
+/// result) can be told apart, and the instant it started (temporary files older than it
+/// cannot be its own).
+#[derive(Debug, Clone)]
+pub struct Invocation {
+    /// `<unix seconds>.<nanoseconds>-<pid>`: the start instant and the process, unique on one
+    /// machine and sortable by start time.
+    pub id: String,
+    pub started: SystemTime,
+}
+
+/// This process's invocation, fixed at the first call: the binary calls it first thing so that
+/// `started` is its start.
+pub fn invocation() -> &'static Invocation {
+    static INVOCATION: OnceLock<Invocation> = OnceLock::new();
+    INVOCATION.get_or_init(|| {
+        let started = SystemTime::now();
+        let since = started.duration_since(UNIX_EPOCH).unwrap_or_default();
+        Invocation {
+            id: format!(
+                "{}.{:09}-{}",
+                since.as_secs(),
+                since.subsec_nanos(),
+                std::process::id()
+            ),
+            started,
+        }
+    })
+}
+
 /// Writer options with sensible defaults (zstd level 3, 64k rows per group).
 #[derive(Debug, Clone)]
 pub struct TableOptions {
@@ -112,10 +144,13 @@ impl Default for TableOptions {
         Self {
             zstd_level: 3,
             row_group_rows: 65_536,
-            metadata: vec![(
-                "pendulum_version".to_string(),
-                env!("CARGO_PKG_VERSION").to_string(),
-            )],
+            metadata: vec![
+                (
+                    "pendulum_version".to_string(),
+                    env!("CARGO_PKG_VERSION").to_string(),
+                ),
+                ("invocation_id".to_string(), invocation().id.clone()),
+            ],
         }
     }
 }
@@ -157,6 +192,23 @@ fn tmp_path(path: &Path) -> PathBuf {
         .unwrap_or_else(|| "table.parquet".into());
     let n = COUNTER.fetch_add(1, Ordering::Relaxed);
     path.with_file_name(format!(".{name}.{}-{n}.tmp", std::process::id()))
+}
+
+/// The writer's process id when `name` is one of this program's temporary file names:
+/// `.NAME.<pid>-<n>.tmp` (tables here, MCAP logs in `pendulum-log`) or `.NAME.<pid>-<n>.tmp.png`
+/// (plots in `pendulum-plot`, whose encoder picks the format from the extension). Anything else,
+/// a user's own dot-file included, is `None`.
+pub fn temp_writer_pid(name: &str) -> Option<u32> {
+    let stem = name
+        .strip_suffix(".tmp.png")
+        .or_else(|| name.strip_suffix(".tmp"))?;
+    let (base, tag) = stem.strip_prefix('.')?.rsplit_once('.')?;
+    let (pid, n) = tag.split_once('-')?;
+    let digits = |s: &str| !s.is_empty() && s.bytes().all(|b| b.is_ascii_digit());
+    if base.is_empty() || !digits(pid) || !digits(n) {
+        return None;
+    }
+    pid.parse().ok()
 }
 
 fn write_table(
@@ -273,6 +325,32 @@ mod tests {
         }
     }
 
+    /// The temporary names the writers make are recognised, and nothing else is: a stale-temp
+    /// sweep must never take a user's file.
+    #[test]
+    fn issue_13_temporary_names_are_recognised() {
+        let own = tmp_path(Path::new("/out/params.parquet"));
+        let own = own.file_name().unwrap().to_string_lossy().into_owned();
+        assert_eq!(temp_writer_pid(&own), Some(std::process::id()));
+        assert_eq!(temp_writer_pid(".r01.mcap.123-4.tmp"), Some(123));
+        assert_eq!(
+            temp_writer_pid(".history_reference_r01.png.77-0.tmp.png"),
+            Some(77)
+        );
+        for other in [
+            "params.parquet",
+            ".params.parquet.tmp",
+            ".r01.mcap.12a-4.tmp",
+            ".r01.mcap.123-.tmp",
+            ".123-4.tmp",
+            "notes.123-4.tmp",
+            ".bashrc",
+            "campaign.tmp",
+        ] {
+            assert_eq!(temp_writer_pid(other), None, "{other}");
+        }
+    }
+
     #[test]
     fn round_trip_with_units_and_metadata() {
         let dir = tempfile::tempdir().unwrap();
@@ -298,6 +376,9 @@ mod tests {
         assert!(kv
             .iter()
             .any(|k| k.key == "steady_state" && k.value.as_deref() == Some("rest")));
+        assert!(kv
+            .iter()
+            .any(|k| k.key == "invocation_id" && k.value.as_deref() == Some(&invocation().id)));
         let batches: Vec<_> =
             parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder::try_new(
                 File::open(&path).unwrap(),

@@ -189,6 +189,14 @@ impl TwinRun {
 /// Fraction of the set speed that counts as "at speed" for the truth's t = 0.
 pub const AT_SPEED: f64 = 0.99;
 
+/// The longest run the twin simulates, s (`free_s + forced_s`): 4 hours. The twin holds a whole
+/// run in memory while it integrates: per sample its stamp (8 bytes), an event (24), the
+/// integrator's output time (8) and the value (8; the capture's text or frames come on top,
+/// about 40 more), ≈ 90 bytes, at up to 1,200 samples/s (sd: encoder 1 kHz + accelerometer
+/// 200 Hz): 14,400 s × 1,200 × 90 B ≈ 1.6 GB. The study's runs last tens of seconds; a
+/// `forced_s = 1e9` asked for 10⁵ TB and aborted on allocation (exit 134).
+pub const MAX_RUN_S: f64 = 4.0 * 3600.0;
+
 fn default_free_s() -> f64 {
     4.0
 }
@@ -271,6 +279,20 @@ impl TwinCase {
                 expected: e.to_string(),
             })?;
         for run in &case.runs {
+            let duration_s = run.free_s + run.forced_s;
+            if !(duration_s <= MAX_RUN_S) {
+                return Err(RigError::CampaignKey {
+                    path: path.to_path_buf(),
+                    run: Some(run.id.clone()),
+                    key: "forced_s".into(),
+                    expected: format!(
+                        "free_s + forced_s of at most {MAX_RUN_S} s (4 h), not {} + {} s: the twin \
+                         holds a run's samples in memory, about 90 bytes each at up to 1,200 a \
+                         second (1.6 GB at the limit)",
+                        run.free_s, run.forced_s
+                    ),
+                });
+            }
             run.physical(&case)
                 .validate()
                 .map_err(|e| RigError::CampaignKey {
