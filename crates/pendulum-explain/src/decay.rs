@@ -2144,7 +2144,10 @@ pub fn diagnose_decay(
                 opts.z
             )
         } else {
-            format!("loss per cycle contradicts the measured: {}", contradicted.join("; "))
+            format!(
+                "loss per cycle contradicts the measured: {}",
+                contradicted.join("; ")
+            )
         });
         let evidence = evidence.join(" | ");
         let verdict = if ok {
@@ -2507,21 +2510,30 @@ struct EnvelopeSupport {
 /// The envelope's catalogue fit for each added loss term (a dry term stands for the other when
 /// their loss curves cannot be told apart over the amplitudes seen). Empty for a stiffness.
 fn envelope_support(env: &EnvelopeFit, add: &[Term], ests: &[Estimate]) -> Vec<EnvelopeSupport> {
-    let amps: Vec<f64> = env.rows.iter().filter_map(|r| r.mid_amplitude_rad).collect();
+    let amps: Vec<f64> = env
+        .rows
+        .iter()
+        .filter_map(|r| r.mid_amplitude_rad)
+        .collect();
     let curve = |t: Term| -> Vec<f64> { amps.iter().map(|&a| t.loss_per_cycle(a)).collect() };
-    let dry_alike = correlation(
-        &curve(Term::CoulombConstant),
-        &curve(Term::CoulombBearing),
-    ) > 0.995;
+    let dry_alike =
+        correlation(&curve(Term::CoulombConstant), &curve(Term::CoulombBearing)) > 0.995;
     add.iter()
         .zip(ests)
         .filter(|(t, _)| **t != Term::Stiffness)
         .map(|(&t, e)| {
-            let found = env.catalogue.iter().find(|c| c.name == t.name()).or_else(|| {
-                env.catalogue
-                    .iter()
-                    .find(|c| dry_alike && t.is_dry() && c.name != t.name() && c.name.starts_with("coulomb"))
-            });
+            let found = env
+                .catalogue
+                .iter()
+                .find(|c| c.name == t.name())
+                .or_else(|| {
+                    env.catalogue.iter().find(|c| {
+                        dry_alike
+                            && t.is_dry()
+                            && c.name != t.name()
+                            && c.name.starts_with("coulomb")
+                    })
+                });
             match found {
                 Some(c) => {
                     let resolved = c.ci_low > 0.0;
@@ -3235,7 +3247,11 @@ mod tests {
             d.is_accepted(Term::CoulombConstant),
             "dry friction not named:\n{text}"
         );
-        assert_eq!(d.best.terms, ["viscous_linear", "coulomb_constant"], "{text}");
+        assert_eq!(
+            d.best.terms,
+            ["viscous_linear", "coulomb_constant"],
+            "{text}"
+        );
         // Viscous kept (its interval clear of 0, which it was not on the recording);
         // the trajectory fit's dry interval is wide (the creep), the envelope's is not.
         let e = d.best.params.iter().find(|p| p.name == "beta").unwrap();
@@ -3258,7 +3274,11 @@ mod tests {
             "the held-out rule alone accepts it here: {}",
             cand.verdict
         );
-        assert!(cand.verdict.contains("the envelope resolves it"), "{}", cand.verdict);
+        assert!(
+            cand.verdict.contains("the envelope resolves it"),
+            "{}",
+            cand.verdict
+        );
         assert!(cand.verdict.contains("envelope: "), "{}", cand.verdict);
         assert!(cand.verdict.contains("loss per cycle"), "{}", cand.verdict);
         assert!(text.contains(DECAY_RULE), "{text}");
@@ -3299,12 +3319,18 @@ mod tests {
         false_drag.x.push(0.25);
         let bad = loss_contradictions(&d.envelope, &d.best, &false_drag, opts.z);
         eprintln!("{bad:?}");
-        assert!(!bad.is_empty(), "a quadratic drag of 0.25 passes the loss check");
+        assert!(
+            !bad.is_empty(),
+            "a quadratic drag of 0.25 passes the loss check"
+        );
         let worst = loss_bands(&d.envelope, &d.best, &false_drag)
             .iter()
             .map(|b| b.best_model_rad / b.measured_rad)
             .fold(0.0, f64::max);
-        assert!(worst > 3.0, "the false drag loses only {worst:.2}× the measured");
+        assert!(
+            worst > 3.0,
+            "the false drag loses only {worst:.2}× the measured"
+        );
     }
 
     /// A free decay θ'' = −ω_g² sin θ − (k/I) θ − γ θ' by classical RK4 (its own integrator, not
@@ -3318,7 +3344,8 @@ mod tests {
         duration_s: f64,
         fs_hz: f64,
     ) -> (Vec<f64>, Vec<f64>) {
-        let f = |th: f64, w: f64| -> f64 { -omega_g * omega_g * th.sin() - k_over_i * th - gamma * w };
+        let f =
+            |th: f64, w: f64| -> f64 { -omega_g * omega_g * th.sin() - k_over_i * th - gamma * w };
         let q = std::f64::consts::TAU / 4096.0;
         let n = (duration_s * fs_hz) as usize;
         let h = 1.0 / (10.0 * fs_hz);
@@ -3370,14 +3397,21 @@ mod tests {
         eprintln!("{text}");
         let law = d.period_law.as_ref().expect("no period law");
         assert!(law.departs, "{}", law.describe());
-        assert!(d.is_accepted(Term::Stiffness), "stiffness not named:\n{text}");
+        assert!(
+            d.is_accepted(Term::Stiffness),
+            "stiffness not named:\n{text}"
+        );
         let k_est = d.best.term_value(Term::Stiffness);
         assert!(
             (k_est / kappa - 1.0).abs() < 0.10,
             "kappa {k_est} vs the truth {kappa}"
         );
         let wn = omega_g * (1.0 + kappa).sqrt();
-        assert!((d.best.omega_n() / wn - 1.0).abs() < 0.01, "{} vs {wn}", d.best.omega_n());
+        assert!(
+            (d.best.omega_n() / wn - 1.0).abs() < 0.01,
+            "{} vs {wn}",
+            d.best.omega_n()
+        );
         // Nothing left over: no period drift, and the loss per cycle of the spring-loaded
         // potential (not gravity's) matches the envelope.
         assert!(d.unexplained.is_empty(), "{:?}", d.unexplained);
