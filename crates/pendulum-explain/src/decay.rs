@@ -8,6 +8,8 @@
 //! θ̈ = −ω_n² sin θ − γ θ̇ − q θ̇|θ̇| − (T_c/I + (μ r_b m g/I)·N) sgn θ̇,    ω_n² = m g a / I
 //! ```
 //!
+//! (with a stiffness term, `− (k/I) θ` besides, and ω_n² above becomes ω_g², gravity's share)
+//!
 //! (a = pivot to centre of mass). Only these ratios are identifiable from θ(t): I, m·a and the
 //! torques cannot be separated without knowing m and a. The fits run in the model crate's
 //! dimensionless form with time in units of 1/ω_n: β = γ/ω_n (`viscous_linear`), c = T_c/(I ω_n²)
@@ -28,11 +30,19 @@
 //!    integrated autocorrelation time (the residuals of a physical fit are not white).
 //! 3. Held-out gain: every model is fitted on the first half of the swings; the rest of the motion
 //!    is simulated in one piece from the measured turning point at the split and scored by
-//!    E_θ = Σ|θ_meas − θ_sim|. A term is accepted only if its interval excludes 0 and the held-out
-//!    E_θ falls by more than the block-to-block scatter of the improvement (2 standard errors)
-//!    explains. Terms are added greedily (forward selection) to the base model (viscous only).
-//! 4. What stays unexplained: the half period's drift with amplitude beyond the exact pendulum
-//!    period (elliptic K), residual structure by amplitude band, the final rest position.
+//!    E_θ = Σ|θ_meas − θ_sim|. One decay law, three views ([`DECAY_RULE`], issue 16): a term
+//!    whose model contradicts the measured loss per cycle (the loss bands) is never accepted;
+//!    otherwise it is accepted if its interval excludes 0 and the held-out E_θ falls by more
+//!    than the block-to-block scatter of the improvement (2 standard errors) explains, or if
+//!    the envelope resolves it (interval clear of 0), the trajectory fit agrees with the
+//!    envelope within intervals and the held-out E_θ gets no worse than that scatter (the
+//!    held-out noise can exceed a small effect that the envelope measures directly). Terms are
+//!    added greedily (forward selection) to the base model (viscous only).
+//! 4. A linear stiffness (a torsion spring beside gravity) is tried only when the half periods
+//!    do not follow the gravity law ([`PeriodLaw`]).
+//! 5. What stays unexplained: the half period's drift with amplitude beyond the exact pendulum
+//!    period (elliptic K, with the fitted stiffness), residual structure by amplitude band, the
+//!    final rest position.
 
 use std::fmt;
 use std::ops::ControlFlow;
@@ -3379,9 +3389,10 @@ mod tests {
     }
 
     /// Issue 16 item 5: a pendulum with a torsion spring as stiff as gravity (κ = k/(m g a) = 1,
-    /// so half its small-swing stiffness is the spring's) released from 1.2 rad: its period
-    /// lengthens with amplitude half as much as gravity alone would, the stiffness is named with
-    /// κ within 10 %, and the period drift it left unexplained is gone. A plain gravity pendulum
+    /// so half its small-swing stiffness is the spring's), and one dominated by its spring
+    /// (κ = 5), released from 1.2 rad: the period lengthens with amplitude 1/(1 + κ) as much as
+    /// gravity alone would make it, the stiffness is named with κ within 10 %, and the period
+    /// drift it left unexplained is gone. A plain gravity pendulum
     /// (the same run without the spring) gets nothing named, the stiffness not even tried.
     #[test]
     fn regression_issue_16_torsion_spring_named_as_stiffness() {
@@ -3390,31 +3401,33 @@ mod tests {
             resolution_rad: Some(std::f64::consts::TAU / 4096.0),
             ..DecayOptions::default()
         };
-        let kappa = 1.0;
-        let (t, th) = rk4_spring_decay(omega_g, kappa * omega_g * omega_g, gamma, 1.2, 30.0, 200.0);
-        let d = diagnose_decay(&t, &th, &opts).unwrap();
-        let text = d.to_string();
-        eprintln!("{text}");
-        let law = d.period_law.as_ref().expect("no period law");
-        assert!(law.departs, "{}", law.describe());
-        assert!(
-            d.is_accepted(Term::Stiffness),
-            "stiffness not named:\n{text}"
-        );
-        let k_est = d.best.term_value(Term::Stiffness);
-        assert!(
-            (k_est / kappa - 1.0).abs() < 0.10,
-            "kappa {k_est} vs the truth {kappa}"
-        );
-        let wn = omega_g * (1.0 + kappa).sqrt();
-        assert!(
-            (d.best.omega_n() / wn - 1.0).abs() < 0.01,
-            "{} vs {wn}",
-            d.best.omega_n()
-        );
-        // Nothing left over: no period drift, and the loss per cycle of the spring-loaded
-        // potential (not gravity's) matches the envelope.
-        assert!(d.unexplained.is_empty(), "{:?}", d.unexplained);
+        for kappa in [1.0, 5.0] {
+            let (t, th) =
+                rk4_spring_decay(omega_g, kappa * omega_g * omega_g, gamma, 1.2, 30.0, 200.0);
+            let d = diagnose_decay(&t, &th, &opts).unwrap();
+            let text = d.to_string();
+            eprintln!("{text}");
+            let law = d.period_law.as_ref().expect("no period law");
+            assert!(law.departs, "{}", law.describe());
+            assert!(
+                d.is_accepted(Term::Stiffness),
+                "stiffness not named:\n{text}"
+            );
+            let k_est = d.best.term_value(Term::Stiffness);
+            assert!(
+                (k_est / kappa - 1.0).abs() < 0.10,
+                "kappa {k_est} vs the truth {kappa}"
+            );
+            let wn = omega_g * (1.0 + kappa).sqrt();
+            assert!(
+                (d.best.omega_n() / wn - 1.0).abs() < 0.01,
+                "{} vs {wn}",
+                d.best.omega_n()
+            );
+            // Nothing left over: no period drift, and the loss per cycle of the spring-loaded
+            // potential (not gravity's) matches the envelope.
+            assert!(d.unexplained.is_empty(), "{:?}", d.unexplained);
+        }
 
         let (t, th) = rk4_spring_decay(omega_g, 0.0, gamma, 1.2, 30.0, 200.0);
         let d = diagnose_decay(&t, &th, &opts).unwrap();
