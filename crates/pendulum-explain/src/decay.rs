@@ -2113,7 +2113,7 @@ pub fn diagnose_decay(
         // trajectory fit agrees with it, and the held-out score, whose noise can exceed a small
         // effect (a dry loss that matters only at the last few-count swings), is not worse.
         let contradicted = loss_contradictions(&env, full_cur, &full, opts.z);
-        let envelope = envelope_support(&env, add, &ests);
+        let envelope = envelope_support(&env, current, add, &ests);
         let not_worse = gain > -noise_gain;
         let by_heldout = excludes_zero && beats_noise;
         let by_envelope = !envelope.is_empty() && envelope.iter().all(|e| e.agrees) && not_worse;
@@ -2518,8 +2518,16 @@ struct EnvelopeSupport {
 }
 
 /// The envelope's catalogue fit for each added loss term (a dry term stands for the other when
-/// their loss curves cannot be told apart over the amplitudes seen). Empty for a stiffness.
-fn envelope_support(env: &EnvelopeFit, add: &[Term], ests: &[Estimate]) -> Vec<EnvelopeSupport> {
+/// their loss curves cannot be told apart over the amplitudes seen, unless the other is already
+/// in the model or added with it: the envelope's dry loss is then claimed). Empty for a
+/// stiffness.
+fn envelope_support(
+    env: &EnvelopeFit,
+    current: &[Term],
+    add: &[Term],
+    ests: &[Estimate],
+) -> Vec<EnvelopeSupport> {
+    let claimed = |name: &str| current.iter().chain(add).any(|t| t.name() == name);
     let amps: Vec<f64> = env
         .rows
         .iter()
@@ -2540,8 +2548,8 @@ fn envelope_support(env: &EnvelopeFit, add: &[Term], ests: &[Estimate]) -> Vec<E
                     env.catalogue.iter().find(|c| {
                         dry_alike
                             && t.is_dry()
-                            && c.name != t.name()
                             && c.name.starts_with("coulomb")
+                            && !claimed(&c.name)
                     })
                 });
             match found {
