@@ -887,3 +887,89 @@ fn regression_issue_12_forcing_not_understood_is_flagged() {
 fn regression_issue_12_finds_dry_torque_and_tilt_together() {
     assert_pair_found(3003, 7003, "coulomb_constant", "horizontal_base");
 }
+
+/// Issue 16 item 1 through `discover --base linear`: the issue's recording as a twin (the decay
+/// law's β = 2ζ = 0.0112 and c = 2.5e-4 rad, i.e. 5·10⁻⁴ rad of dry loss per half cycle, so the
+/// amplitude falls exponentially at large swings and linearly below ~2°), ω_n = 6 rad/s from
+/// 0.35 rad, 90 s at 150 Hz, written as 4096-count encoder readings whose zero creeps ±2 counts
+/// over 23 s (what a real stand does and a twin lacks: it makes the held-out rule's noise larger
+/// than the dry term's effect on E_theta, as on the issue's recording). The envelope resolves
+/// the dry loss, so the dry term is accepted and viscous kept (its interval clear of 0), both
+/// within their intervals of the truth, and the report states the decision rule.
+#[test]
+fn regression_issue_16_discover_linear_base_names_dry_with_viscous() {
+    use pendulum_model::{Dimensionless, Excitation, Model, SimOptions};
+    let (beta, c, omega_n, fs_hz) = (0.0112, 2.5e-4, 6.0, 150.0);
+    let d = Dimensionless {
+        beta,
+        c,
+        ..Dimensionless::conservative()
+    };
+    let tr = pendulum_model::sim::simulate(
+        &Model::with_excitation(d, Excitation::None),
+        &SimOptions::default(),
+        [0.35, 0.0],
+        0.0,
+        90.0 * omega_n,
+        omega_n / fs_hz,
+    )
+    .unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let camp = dir.path().join("campaign");
+    std::fs::create_dir_all(&camp).unwrap();
+    let mut csv = String::from("t_s,count\n");
+    for (tau, th) in tr.t.iter().zip(&tr.theta) {
+        let t_s = tau / omega_n;
+        let creep = 3e-3 * (std::f64::consts::TAU * t_s / 23.0).sin();
+        let count = ((th + creep) * 4096.0 / std::f64::consts::TAU).floor() as i64;
+        csv.push_str(&format!("{t_s:.6},{count}\n"));
+    }
+    std::fs::write(camp.join("decay.csv"), csv).unwrap();
+    // l from ω_n = √(g/l).
+    let l_m = 9.81 / (omega_n * omega_n);
+    std::fs::write(
+        camp.join("campaign.toml"),
+        format!(
+            "name = \"dry-and-viscous\"\n[rig]\nformat = \"timeseries\"\ntime_column = \"t_s\"\nangle_column = \"count\"\nangle_unit = \"counts\"\ncounts_per_rev = 4096\nhanging_angle = 0\nrole = \"identify\"\n[[run]]\nid = \"d0\"\nfile = \"decay.csv\"\nm_kg = 1.46\nl_m = {l_m:.6}\n"
+        ),
+    )
+    .unwrap();
+    let s = run(&DiscoverJob {
+        input: camp,
+        out: dir.path().join("out"),
+        base: Base::Linear,
+        pipeline: None,
+        generations: None,
+        seed: None,
+        progress: false,
+    })
+    .unwrap();
+    eprintln!("{s}");
+    assert_eq!(s.decays.len(), 1);
+    let (_, d) = &s.decays[0];
+    assert_eq!(d.base.terms, ["viscous_linear"]);
+    assert!(
+        d.accepted
+            .iter()
+            .any(|t| t == "coulomb_constant" || t == "coulomb_bearing"),
+        "no dry friction named on the linear base:\n{d}"
+    );
+    assert!(
+        !d.accepted.iter().any(|t| t == "viscous_quadratic"),
+        "{:?}",
+        d.accepted
+    );
+    let est = |name: &str| d.best.params.iter().find(|p| p.name == name).unwrap();
+    let b = est("beta");
+    assert!(b.ci_low > 0.0, "viscous not kept: {b:?}");
+    assert!(b.ci_low <= beta && beta <= b.ci_high, "{b:?} vs {beta}");
+    let dry = d
+        .best
+        .params
+        .iter()
+        .find(|p| p.name == "c" || p.name == "M")
+        .unwrap();
+    assert!(dry.ci_low <= c && c <= dry.ci_high, "{dry:?} vs {c}");
+    let report = std::fs::read_to_string(s.out_dir.join("report.md")).unwrap();
+    assert!(report.contains(pendulum_explain::DECAY_RULE), "{report}");
+}

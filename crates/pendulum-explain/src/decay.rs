@@ -8,6 +8,8 @@
 //! θ̈ = −ω_n² sin θ − γ θ̇ − q θ̇|θ̇| − (T_c/I + (μ r_b m g/I)·N) sgn θ̇,    ω_n² = m g a / I
 //! ```
 //!
+//! (with a stiffness term, `− (k/I) θ` besides, and ω_n² above becomes ω_g², gravity's share)
+//!
 //! (a = pivot to centre of mass). Only these ratios are identifiable from θ(t): I, m·a and the
 //! torques cannot be separated without knowing m and a. The fits run in the model crate's
 //! dimensionless form with time in units of 1/ω_n: β = γ/ω_n (`viscous_linear`), c = T_c/(I ω_n²)
@@ -28,11 +30,19 @@
 //!    integrated autocorrelation time (the residuals of a physical fit are not white).
 //! 3. Held-out gain: every model is fitted on the first half of the swings; the rest of the motion
 //!    is simulated in one piece from the measured turning point at the split and scored by
-//!    E_θ = Σ|θ_meas − θ_sim|. A term is accepted only if its interval excludes 0 and the held-out
-//!    E_θ falls by more than the block-to-block scatter of the improvement (2 standard errors)
-//!    explains. Terms are added greedily (forward selection) to the base model (viscous only).
-//! 4. What stays unexplained: the half period's drift with amplitude beyond the exact pendulum
-//!    period (elliptic K), residual structure by amplitude band, the final rest position.
+//!    E_θ = Σ|θ_meas − θ_sim|. One decay law, three views ([`DECAY_RULE`], issue 16): a term
+//!    whose model contradicts the measured loss per cycle (the loss bands) is never accepted;
+//!    otherwise it is accepted if its interval excludes 0 and the held-out E_θ falls by more
+//!    than the block-to-block scatter of the improvement (2 standard errors) explains, or if
+//!    the envelope resolves it (interval clear of 0), the trajectory fit agrees with the
+//!    envelope within intervals and the held-out E_θ gets no worse than that scatter (the
+//!    held-out noise can exceed a small effect that the envelope measures directly). Terms are
+//!    added greedily (forward selection) to the base model (viscous only).
+//! 4. A linear stiffness (a torsion spring beside gravity) is tried only when the half periods
+//!    do not follow the gravity law ([`PeriodLaw`]).
+//! 5. What stays unexplained: the half period's drift with amplitude beyond the exact pendulum
+//!    period (elliptic K, with the fitted stiffness), residual structure by amplitude band, the
+//!    final rest position.
 
 use std::fmt;
 use std::ops::ControlFlow;
@@ -67,6 +77,12 @@ pub enum Term {
     ViscousQuadratic,
     /// M |θ'² + cos θ| sgn θ' (point-mass bearing load).
     CoulombBearing,
+    /// κ θ: a linear restoring torque −k θ besides gravity (a torsion spring, a cable), κ =
+    /// k/(m g a) = k/(I ω_g²) with ω_g² = m g a/I gravity's share; the small-swing ω_n² is
+    /// ω_g²(1 + κ). Not a loss: it shows only in how the period follows the amplitude (the
+    /// spring's share is isochronous, gravity's is not), so it is tried only when the half
+    /// periods do not follow the gravity law (see [`PeriodLaw`]). Not in [`Term::ALL`].
+    Stiffness,
 }
 
 impl Term {
@@ -85,6 +101,7 @@ impl Term {
             Term::CoulombConstant => "coulomb_constant",
             Term::ViscousQuadratic => "viscous_quadratic",
             Term::CoulombBearing => "coulomb_bearing",
+            Term::Stiffness => "stiffness",
         }
     }
 
@@ -95,6 +112,7 @@ impl Term {
             Term::CoulombConstant => "c",
             Term::ViscousQuadratic => "alpha",
             Term::CoulombBearing => "M",
+            Term::Stiffness => "kappa",
         }
     }
 
@@ -105,6 +123,7 @@ impl Term {
             Term::CoulombConstant => "rad",
             Term::ViscousQuadratic => "1/rad",
             Term::CoulombBearing => "1",
+            Term::Stiffness => "1",
         }
     }
 
@@ -118,6 +137,10 @@ impl Term {
             Term::ViscousQuadratic => "alpha = q: quadratic drag torque / (I theta_dot^2)",
             Term::CoulombBearing => {
                 "M = mu r_b m g/(I omega_n^2) (load N = |theta'^2 + cos theta|)"
+            }
+            Term::Stiffness => {
+                "kappa = k/(m g a) = k/(I omega_g^2): restoring torque -k theta beside gravity \
+                 (omega_n^2 = omega_g^2 (1 + kappa))"
             }
         }
     }
@@ -133,13 +156,14 @@ impl Term {
             Term::CoulombConstant => d.c = v,
             Term::ViscousQuadratic => d.alpha = v,
             Term::CoulombBearing => d.m_coulomb = v,
+            Term::Stiffness => d.kappa = v,
         }
     }
 
     /// Finite-difference step floor.
     fn fd_floor(self) -> f64 {
         match self {
-            Term::ViscousLinear | Term::ViscousQuadratic => 1e-6,
+            Term::ViscousLinear | Term::ViscousQuadratic | Term::Stiffness => 1e-6,
             Term::CoulombConstant | Term::CoulombBearing => 1e-7,
         }
     }
@@ -148,15 +172,26 @@ impl Term {
     /// exact pendulum to first order in the damping: the energy a term takes over a half swing,
     /// ∫ f(θ, θ') dθ with θ'² = 2(cos θ − cos A), divided by dE/dA = sin A, times two.
     pub fn loss_per_cycle(self, a: f64) -> f64 {
+        self.loss_per_cycle_with(a, 0.0)
+    }
+
+    /// [`Term::loss_per_cycle`] with a stiffness κ beside gravity: the potential is
+    /// 1 − cos θ + κθ²/2, so θ'² = 2(V(A) − V(θ)) and dE/dA = sin A + κA. A stiffness takes no
+    /// energy (0).
+    pub fn loss_per_cycle_with(self, a: f64, kappa: f64) -> f64 {
+        if self == Term::Stiffness {
+            return 0.0;
+        }
         let a = a.clamp(1e-9, std::f64::consts::PI - 1e-3);
         let ca = a.cos();
         let f = |th: f64| -> f64 {
-            let w2 = (2.0 * (th.cos() - ca)).max(0.0);
+            let w2 = (2.0 * (th.cos() - ca) + kappa * (a * a - th * th)).max(0.0);
             match self {
                 Term::CoulombConstant => 1.0,
                 Term::ViscousLinear => w2.sqrt(),
                 Term::ViscousQuadratic => w2,
                 Term::CoulombBearing => (w2 + th.cos()).abs(),
+                Term::Stiffness => 0.0,
             }
         };
         // θ = A sin φ removes the square-root end points; Simpson on φ ∈ [−π/2, π/2].
@@ -174,7 +209,7 @@ impl Term {
             };
             s += w * f(a * phi.sin()) * a * phi.cos();
         }
-        2.0 * (s * h / 3.0) / a.sin()
+        2.0 * (s * h / 3.0) / (a.sin() + kappa * a)
     }
 }
 
@@ -207,7 +242,8 @@ pub struct DecayOptions {
     /// The model in hand (default: viscous only, the classic free-decay model).
     pub base: Vec<Term>,
     /// Terms to try adding, in order of preference (default: `coulomb_constant`,
-    /// `viscous_quadratic`, `coulomb_bearing`).
+    /// `viscous_quadratic`, `coulomb_bearing`, and `stiffness` where the period does not follow
+    /// the gravity law).
     pub candidates: Vec<Term>,
     pub rig: Option<KnownRig>,
     pub reference: Option<ReferenceModel>,
@@ -239,6 +275,7 @@ impl Default for DecayOptions {
                 Term::CoulombConstant,
                 Term::ViscousQuadratic,
                 Term::CoulombBearing,
+                Term::Stiffness,
             ],
             rig: None,
             reference: None,
@@ -401,8 +438,14 @@ pub struct ModelFit {
 }
 
 impl ModelFit {
-    /// ω_n, rad/s.
+    /// The small-swing ω_n, rad/s: ω_g √(1 + κ) (ω_g alone without a stiffness term).
     pub fn omega_n(&self) -> f64 {
+        self.x[0] * (1.0 + self.term_value(Term::Stiffness)).sqrt()
+    }
+
+    /// The model's time scale ω_g, rad/s: gravity's share of ω_n (all of it without a
+    /// stiffness term), the unit the simulation's time is counted in.
+    pub fn omega_g(&self) -> f64 {
         self.x[0]
     }
 
@@ -513,6 +556,10 @@ pub struct DecayDiagnosis {
     /// Fits use the first half of the swings; the held-out part starts here.
     pub t_split_s: f64,
     pub envelope: EnvelopeFit,
+    /// How the half period follows the amplitude (gravity law or a stiffness beside it);
+    /// `None` with too few large swings.
+    #[serde(default)]
+    pub period_law: Option<PeriodLaw>,
     /// Loss per cycle by amplitude band: measured, base model, best model and its terms.
     pub loss_bands: Vec<LossBand>,
     /// The model in hand, fitted to the whole motion.
@@ -550,9 +597,10 @@ impl DecayDiagnosis {
 impl ModelFit {
     /// The model's loss of amplitude per cycle at amplitude `a` (first order in the damping).
     pub fn loss_per_cycle(&self, a: f64) -> f64 {
+        let kappa = self.term_value(Term::Stiffness);
         self.term_list
             .iter()
-            .map(|&t| self.term_value(t) * t.loss_per_cycle(a))
+            .map(|&t| self.term_value(t) * t.loss_per_cycle_with(a, kappa))
             .sum()
     }
 }
@@ -879,6 +927,193 @@ fn ellip_k(k: f64) -> f64 {
 /// Half period of the undamped pendulum at amplitude A, in units of 1/ω_n.
 fn half_period_factor(a: f64) -> f64 {
     2.0 * ellip_k((0.5 * a).sin())
+}
+
+/// Half period of the undamped pendulum with restoring torque −u sin θ − (1 − u) θ (u = 1/(1 + κ):
+/// gravity's share of the small-swing stiffness) at amplitude A, in units of 1/ω_n:
+/// 2∫₀^{π/2} A cos φ dφ / √(2u(cos(A sin φ) − cos A) + (1 − u)A² cos² φ) (θ = A sin φ), by
+/// Simpson; the end φ = π/2 is the integrand's limit A/√(uA sin A + (1 − u)A²).
+fn half_period_mix(a: f64, u: f64) -> f64 {
+    let a = a.clamp(1e-9, std::f64::consts::PI - 1e-3);
+    let u = u.clamp(0.0, 1.0);
+    let g = |phi: f64| -> f64 {
+        let c = phi.cos();
+        if c <= 1e-12 {
+            return a / (u * a * a.sin() + (1.0 - u) * a * a).sqrt();
+        }
+        let x = a * phi.sin();
+        // cos x − cos A without cancellation: 2 sin((A + x)/2) sin((A − x)/2), A − x = A c²/(1 + sin φ).
+        let dc = 2.0 * (0.5 * (a + x)).sin() * (0.5 * a * c * c / (1.0 + phi.sin())).sin();
+        a * c / (2.0 * u * dc + (1.0 - u) * a * a * c * c).sqrt()
+    };
+    let n = 64;
+    let h = std::f64::consts::FRAC_PI_2 / n as f64;
+    let mut s = 0.0;
+    for k in 0..=n {
+        let w = if k == 0 || k == n {
+            1.0
+        } else if k % 2 == 1 {
+            4.0
+        } else {
+            2.0
+        };
+        s += w * g(k as f64 * h);
+    }
+    2.0 * s * h / 3.0
+}
+
+/// Half period at amplitude A with a stiffness κ beside gravity, in units of 1/ω_g (the model's
+/// time): [`half_period_factor`] when κ = 0.
+fn half_period_units(a: f64, kappa: f64) -> f64 {
+    if kappa == 0.0 {
+        return half_period_factor(a);
+    }
+    let k1 = 1.0 + kappa.max(0.0);
+    half_period_mix(a, 1.0 / k1) / k1.sqrt()
+}
+
+/// How the half period follows the amplitude: fitted as the period of θ'' = −u sin θ − (1 − u)θ
+/// (gravity plus a linear stiffness κ = (1 − u)/u) to the larger swings' half periods. Gravity
+/// alone (u = 1) lengthens the period by about A²/16; a spring's share does not, so the
+/// amplitude dependence measures it, whatever ω_n is.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PeriodLaw {
+    /// Half swings used (amplitude ≥ 30 % of the largest and ≥ 20 resolution steps).
+    pub swings: usize,
+    pub amplitude_from_rad: f64,
+    pub amplitude_to_rad: f64,
+    /// u = 1/(1 + κ): gravity's share of the small-swing stiffness, with its interval.
+    pub gravity_share: f64,
+    pub gravity_share_ci_low: f64,
+    pub gravity_share_ci_high: f64,
+    /// κ = (1 − u)/u and its interval (from u's).
+    pub kappa: f64,
+    pub kappa_ci_low: f64,
+    pub kappa_ci_high: f64,
+    /// The small-swing ω_n, rad/s.
+    pub omega_n_rad_s: f64,
+    /// Rms relative misfit of the half periods.
+    pub rms_rel: f64,
+    /// The interval of u excludes 1: the period does not follow the gravity law.
+    pub departs: bool,
+}
+
+impl PeriodLaw {
+    /// One line for the report.
+    pub fn describe(&self) -> String {
+        format!(
+            "period law ({} half swings, A {:.3}–{:.3} rad, rms {:.2} %): gravity's share of the \
+             small-swing stiffness u = {:.4} [{:.4}, {:.4}], kappa = {:.3e} [{:.3e}, {:.3e}]: {}",
+            self.swings,
+            self.amplitude_from_rad,
+            self.amplitude_to_rad,
+            100.0 * self.rms_rel,
+            self.gravity_share,
+            self.gravity_share_ci_low,
+            self.gravity_share_ci_high,
+            self.kappa,
+            self.kappa_ci_low,
+            self.kappa_ci_high,
+            if self.departs {
+                "the period does not follow the gravity law (stiffness tried)"
+            } else {
+                "the period follows the gravity law (stiffness not tried)"
+            }
+        )
+    }
+}
+
+/// Fits [`PeriodLaw`] to the turning points; `None` with fewer than 6 usable half swings.
+fn period_law(tps: &[TurningPoint], step_rad: f64, z: f64) -> Option<PeriodLaw> {
+    let sw: Vec<(f64, f64)> = tps
+        .windows(2)
+        .map(|w| {
+            (
+                0.5 * (w[0].theta_rad - w[1].theta_rad).abs(),
+                w[1].t_s - w[0].t_s,
+            )
+        })
+        .collect();
+    let amax = sw.iter().map(|s| s.0).fold(0.0, f64::max);
+    // Only the larger swings: the amplitude dependence is there (∝ A²), and the encoder's
+    // staircase times the small ones (see the period-drift allowance).
+    let sel: Vec<(f64, f64)> = sw
+        .into_iter()
+        .filter(|s| s.0 >= 0.3 * amax && s.0 >= 20.0 * step_rad && s.1 > 0.0)
+        .collect();
+    let n = sel.len();
+    if n < 6 {
+        return None;
+    }
+    // log h = log(1/ω_n) + log P(A, u); the intercept is profiled out.
+    let resid = |u: f64| -> (Vec<f64>, f64) {
+        let r: Vec<f64> = sel
+            .iter()
+            .map(|&(a, h)| h.ln() - half_period_mix(a, u).ln())
+            .collect();
+        let m = r.iter().sum::<f64>() / n as f64;
+        let r: Vec<f64> = r.iter().map(|v| v - m).collect();
+        (r, m)
+    };
+    let rss = |u: f64| resid(u).0.iter().map(|v| v * v).sum::<f64>();
+    // Golden section on u ∈ [0, 1] (the misfit is smooth in u).
+    let (mut lo, mut hi) = (0.0f64, 1.0f64);
+    let g = 0.5 * (5f64.sqrt() - 1.0);
+    let (mut x1, mut x2) = (hi - g * (hi - lo), lo + g * (hi - lo));
+    let (mut f1, mut f2) = (rss(x1), rss(x2));
+    for _ in 0..60 {
+        if f1 < f2 {
+            hi = x2;
+            x2 = x1;
+            f2 = f1;
+            x1 = hi - g * (hi - lo);
+            f1 = rss(x1);
+        } else {
+            lo = x1;
+            x1 = x2;
+            f1 = f2;
+            x2 = lo + g * (hi - lo);
+            f2 = rss(x2);
+        }
+    }
+    let mut u = 0.5 * (lo + hi);
+    for end in [0.0, 1.0] {
+        if rss(end) <= rss(u) {
+            u = end;
+        }
+    }
+    let (r, m) = resid(u);
+    let s2 = r.iter().map(|v| v * v).sum::<f64>() / (n - 2) as f64;
+    // Sensitivity of log P to u (one-sided at the ends), centred: the profiled intercept.
+    let hstep = 1e-4;
+    let (ua, ub) = ((u - hstep).max(0.0), (u + hstep).min(1.0));
+    let gr: Vec<f64> = sel
+        .iter()
+        .map(|&(a, _)| (half_period_mix(a, ub).ln() - half_period_mix(a, ua).ln()) / (ub - ua))
+        .collect();
+    let gm = gr.iter().sum::<f64>() / n as f64;
+    let sgg: f64 = gr.iter().map(|v| (v - gm) * (v - gm)).sum();
+    let se = if sgg > 0.0 {
+        (s2 / sgg).sqrt()
+    } else {
+        f64::INFINITY
+    };
+    let (u_lo, u_hi) = ((u - z * se).max(1e-9), u + z * se);
+    let kap = |u: f64| (1.0 - u.max(1e-9)) / u.max(1e-9);
+    Some(PeriodLaw {
+        swings: n,
+        amplitude_from_rad: sel.iter().map(|s| s.0).fold(f64::INFINITY, f64::min),
+        amplitude_to_rad: amax,
+        gravity_share: u,
+        gravity_share_ci_low: u_lo,
+        gravity_share_ci_high: u_hi,
+        kappa: kap(u),
+        kappa_ci_low: kap(u_hi).max(0.0),
+        kappa_ci_high: kap(u_lo),
+        omega_n_rad_s: (-m).exp(),
+        rms_rel: (s2 * (n - 2) as f64 / n as f64).sqrt(),
+        departs: u_hi < 1.0,
+    })
 }
 
 /// The small-swing natural frequency ω_n, rad/s, from successive turning points: the median over
@@ -1562,8 +1797,19 @@ fn estimate(name: &str, v: f64, var: f64, z: f64, unit: &str) -> Estimate {
 fn params_of(fit: &ModelFit, z: f64) -> Vec<Estimate> {
     let p = fit.x.len();
     let var = |j: usize| fit.cov[j * p + j];
+    let stiff = fit.term_list.contains(&Term::Stiffness);
     let mut v = vec![
-        estimate("omega_n", fit.x[0], var(0), z, "rad/s"),
+        estimate(
+            if stiff {
+                "omega_g (gravity's share of omega_n)"
+            } else {
+                "omega_n"
+            },
+            fit.x[0],
+            var(0),
+            z,
+            "rad/s",
+        ),
         estimate("theta_offset", fit.x[1], var(1), z, "rad"),
     ];
     for (k, t) in fit.term_list.iter().enumerate() {
@@ -1641,6 +1887,17 @@ fn term_physical(fit: &ModelFit, t: Term, opts: &DecayOptions) -> Vec<Estimate> 
                 }
             }
         }
+        Term::Stiffness => {
+            push("k/I", "rad/s²", &|x| x[j] * x[0] * x[0]);
+            push(
+                "k/(I omega_n²): the spring's share of the small-swing stiffness",
+                "1",
+                &|x| x[j] / (1.0 + x[j]),
+            );
+            if let Some(mga) = mga {
+                push("k (torsion stiffness)", "N·m/rad", &|x| x[j] * mga);
+            }
+        }
     }
     out
 }
@@ -1648,9 +1905,16 @@ fn term_physical(fit: &ModelFit, t: Term, opts: &DecayOptions) -> Vec<Estimate> 
 fn physical_of(fit: &ModelFit, opts: &DecayOptions) -> Vec<Estimate> {
     let z = opts.z;
     let mut out = Vec::new();
-    let (v, var) = derived(fit, &|x| x[0] / std::f64::consts::TAU);
+    // Small swings: ω_n = ω_g √(1 + κ) (κ = 0 without a stiffness term).
+    let ks = fit.term_list.iter().position(|&t| t == Term::Stiffness);
+    let wn = move |x: &[f64]| x[0] * (1.0 + ks.map_or(0.0, |k| x[2 + k])).sqrt();
+    if ks.is_some() {
+        let (v, var) = derived(fit, &wn);
+        out.push(estimate("omega_n (small swings)", v, var, z, "rad/s"));
+    }
+    let (v, var) = derived(fit, &|x| wn(x) / std::f64::consts::TAU);
     out.push(estimate("f_n", v, var, z, "Hz"));
-    let (v, var) = derived(fit, &|x| std::f64::consts::TAU / x[0]);
+    let (v, var) = derived(fit, &|x| std::f64::consts::TAU / wn(x));
     out.push(estimate("small-swing period", v, var, z, "s"));
     if let Some(r) = opts.rig {
         let mga = r.m_kg * r.g_m_s2 * r.a_m;
@@ -1718,7 +1982,14 @@ pub fn diagnose_decay(
 
     // Initial guesses: ω_n from the half periods with the exact pendulum's amplitude factor.
     let omega0 = omega_n_estimate(&tps);
-    let init_terms = |terms: &[Term]| -> Vec<f64> {
+    // Does the period follow the gravity law? A stiffness is tried only when it does not.
+    let law = period_law(&tps, env.resolution.step_rad, opts.z);
+    let law_departs = law.as_ref().is_some_and(|l| l.departs);
+    let kappa0 = law
+        .as_ref()
+        .filter(|l| l.departs)
+        .map_or(0.1, |l| l.kappa.clamp(1e-3, 1e3));
+    let init_losses = |terms: &[Term]| -> Vec<f64> {
         let pts: Vec<(f64, f64)> = env
             .rows
             .iter()
@@ -1734,6 +2005,26 @@ pub fn diagnose_decay(
             None => vec![1e-4; terms.len()],
         }
     };
+    // A stiffness takes no energy: it has no loss curve and starts from the period law.
+    let init_terms = |terms: &[Term]| -> Vec<f64> {
+        let losses: Vec<Term> = terms
+            .iter()
+            .copied()
+            .filter(|&t| t != Term::Stiffness)
+            .collect();
+        let b = init_losses(&losses);
+        let mut it = b.into_iter();
+        terms
+            .iter()
+            .map(|&t| {
+                if t == Term::Stiffness {
+                    kappa0
+                } else {
+                    it.next().unwrap_or(1e-4)
+                }
+            })
+            .collect()
+    };
     let x0_for = |terms: &[Term], from: Option<&ModelFit>| -> Vec<f64> {
         let mut x = vec![omega0, env.centre_rad];
         let init = init_terms(terms);
@@ -1744,8 +2035,19 @@ pub fn diagnose_decay(
             };
             x.push(v);
         }
+        // x[0] is the model's time scale ω_g = ω_n/√(1 + κ): the small-swing ω_n carries over
+        // (from the model in hand, or the period law's when a stiffness starts from it).
+        let kappa = terms
+            .iter()
+            .position(|&t| t == Term::Stiffness)
+            .map_or(0.0, |k| x[2 + k]);
+        let w_small = match (from, &law) {
+            (Some(f), _) => f.omega_n(),
+            (None, Some(l)) if kappa > 0.0 && l.departs => l.omega_n_rad_s,
+            _ => omega0,
+        };
+        x[0] = w_small / (1.0 + kappa).sqrt();
         if let Some(f) = from {
-            x[0] = f.omega_n();
             x[1] = f.offset_rad();
         }
         x
@@ -1804,37 +2106,109 @@ pub fn diagnose_decay(
         let excludes_zero = ests.iter().all(|e| e.ci_low > 0.0);
         let used_in_half = add.iter().all(|&t| half.term_value(t) > 0.0);
         let beats_noise = gain > noise_gain && gain > opts.min_heldout_gain;
-        let verdict = if excludes_zero && used_in_half && beats_noise {
+        // The three views of one decay law (see DECAY_RULE). The energy balance vetoes: a term
+        // whose model loses energy per cycle the pendulum does not is wrong whatever the
+        // held-out score says. Then either the trajectory view alone (interval clear of 0 and a
+        // held-out gain beyond its noise), or the envelope's: it resolves the term and the
+        // trajectory fit agrees with it, and the held-out score, whose noise can exceed a small
+        // effect (a dry loss that matters only at the last few-count swings), is not worse.
+        let contradicted = loss_contradictions(&env, full_cur, &full, opts.z);
+        let envelope = envelope_support(&env, current, add, &ests);
+        let not_worse = gain > -noise_gain;
+        let by_heldout = excludes_zero && beats_noise;
+        let by_envelope = !envelope.is_empty() && envelope.iter().all(|e| e.agrees) && not_worse;
+        let ok = contradicted.is_empty() && used_in_half && (by_heldout || by_envelope);
+        let mut evidence = Vec::new();
+        evidence.push(if envelope.is_empty() {
+            "envelope: no loss curve (a stiffness)".to_string()
+        } else {
             format!(
-                "qualifies: interval excludes 0 and held-out E_theta falls {:.1} % (noise explains {:.1} %)",
-                100.0 * gain,
-                100.0 * noise_gain
+                "envelope: {}",
+                envelope
+                    .iter()
+                    .map(|e| e.text.clone())
+                    .collect::<Vec<_>>()
+                    .join("; ")
+            )
+        });
+        evidence.push(format!(
+            "trajectory fit: {}",
+            ests.iter()
+                .map(|e| format!(
+                    "{} = {:.3e} {}",
+                    e.name,
+                    e.estimate,
+                    ci(e.ci_low, e.ci_high)
+                ))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ));
+        evidence.push(format!(
+            "held-out E_theta {:+.1} % (noise {:.1} %)",
+            -100.0 * gain,
+            100.0 * noise_gain
+        ));
+        evidence.push(if contradicted.is_empty() {
+            format!(
+                "loss per cycle within the measured bands (mean ± {:.2}·se, ×{LOSS_BAND_FACTOR})",
+                opts.z
+            )
+        } else {
+            format!(
+                "loss per cycle contradicts the measured: {}",
+                contradicted.join("; ")
+            )
+        });
+        let evidence = evidence.join(" | ");
+        let verdict = if ok {
+            format!(
+                "qualifies ({}): {evidence}",
+                if by_heldout {
+                    "interval excludes 0 and held-out E_theta falls beyond its noise"
+                } else {
+                    "the envelope resolves it, the trajectory fit agrees, held-out E_theta no worse than its noise"
+                }
             )
         } else {
             let mut why = Vec::new();
-            if !excludes_zero {
-                why.push("its interval includes 0".to_string());
+            if !contradicted.is_empty() {
+                why.push("the model with it contradicts the measured loss per cycle".to_string());
             }
             if !used_in_half {
                 why.push("the first-half fit sets it to 0".to_string());
             }
-            if !beats_noise {
-                why.push(format!(
-                    "held-out E_theta changes {:+.1} % (needs a fall of more than {:.1} %: noise \
-                     explains {:.1} %)",
-                    -100.0 * gain,
-                    100.0 * noise_gain.max(opts.min_heldout_gain),
-                    100.0 * noise_gain
+            if !by_heldout && !by_envelope {
+                let mut t = Vec::new();
+                if !excludes_zero {
+                    t.push("its interval includes 0".to_string());
+                }
+                if !beats_noise {
+                    t.push(format!(
+                        "held-out E_theta changes {:+.1} % (needs a fall of more than {:.1} %: \
+                         noise explains {:.1} %)",
+                        -100.0 * gain,
+                        100.0 * noise_gain.max(opts.min_heldout_gain),
+                        100.0 * noise_gain
+                    ));
+                }
+                t.push(format!(
+                    "the envelope {}",
+                    if envelope.is_empty() || !envelope.iter().all(|e| e.agrees) {
+                        "does not resolve it with an interval that agrees"
+                    } else {
+                        "agrees but held-out E_theta gets worse beyond its noise"
+                    }
                 ));
+                why.push(t.join(", "));
             }
-            format!("rejected: {}", why.join("; "))
+            format!("rejected: {}: {evidence}", why.join("; "))
         };
         Ok(Trial {
             add: add.to_vec(),
             full,
             half,
             heldout: h,
-            ok: excludes_zero && used_in_half && beats_noise,
+            ok,
             gain,
             noise_gain,
             gain_cont: 1.0 - ec_ext / ec_cur.max(1e-300),
@@ -1855,11 +2229,13 @@ pub fn diagnose_decay(
     let base_heldout = h_cur.clone();
     let mut candidates = Vec::new();
     let mut accepted = Vec::new();
+    // A stiffness only where the period does not follow the gravity law: it changes nothing
+    // else, and trying it on every decay would only give the held-out noise a chance.
     let mut remaining: Vec<Term> = opts
         .candidates
         .iter()
         .copied()
-        .filter(|t| !current.contains(t))
+        .filter(|t| !current.contains(t) && (*t != Term::Stiffness || law_departs))
         .collect();
     let mut round = 0;
     while !remaining.is_empty() {
@@ -1990,6 +2366,9 @@ pub fn diagnose_decay(
 
     let best = full_cur;
     let mut notes = Vec::new();
+    if let Some(l) = &law {
+        notes.push(l.describe());
+    }
     let loss_bands = loss_bands(&env, &base_full, &best);
     if let (Some(b), Some(x)) = (
         heldout.iter().find(|h| h.model.starts_with("base")),
@@ -2028,6 +2407,7 @@ pub fn diagnose_decay(
         }
     }
     let unexplained = unexplained(&d, &best, &env, noise, t_motion_end, &mut notes)?;
+    notes.push(format!("decision rule: {DECAY_RULE}"));
     let mut not_separable = vec![
         "the inertia I and the gravity moment m·g·a enter only as omega_n² = m g a / I".to_string(),
         "damping torques enter only per unit inertia (gamma = b_theta/I, T_c/I = c·omega_n², q = a_theta/I)".into(),
@@ -2065,6 +2445,7 @@ pub fn diagnose_decay(
         t_motion_to_s: t_motion_end,
         t_split_s: t_split,
         envelope: env,
+        period_law: law,
         loss_bands,
         base: base_full,
         candidates,
@@ -2075,6 +2456,128 @@ pub fn diagnose_decay(
         unexplained,
         notes,
     })
+}
+
+/// The rule [`diagnose_decay`] accepts a term by, as the report states it.
+pub const DECAY_RULE: &str = "a term is never accepted when the model with it contradicts the \
+     measured loss per cycle (in an amplitude band, more than 1.5× above the measured interval's \
+     upper end or below its lower end / 1.5, where the model without it was closer); otherwise it \
+     is accepted when the first-half fit uses it and either (held-out) its trajectory-fit \
+     interval excludes 0 and held-out E_theta falls beyond its noise (and by ≥ 2 %), or \
+     (envelope) the envelope resolves it with an interval clear of 0, the trajectory fit's \
+     interval overlaps the envelope's, and held-out E_theta gets no worse than its noise";
+
+/// Widening of the measured loss-per-cycle interval before a model contradicts it: the
+/// first-order loss curves and the envelope's turning points (parabola-refined, quantised) are
+/// not exact, but a model losing 3–14× the measured energy per cycle (issue 16's false quadratic
+/// drag) is far outside.
+pub const LOSS_BAND_FACTOR: f64 = 1.5;
+
+/// Whether a model contradicts a band's measured loss per cycle: outside the measured interval
+/// (mean ± z·se) widened by [`LOSS_BAND_FACTOR`]. Bands of fewer than 3 cycles have no interval.
+pub fn loss_band_contradicts(b: &LossBand, model_rad: f64, z: f64) -> bool {
+    if b.cycles < 3 || !b.measured_se_rad.is_finite() {
+        return false;
+    }
+    let hi = b.measured_rad + z * b.measured_se_rad;
+    let lo = b.measured_rad - z * b.measured_se_rad;
+    model_rad > LOSS_BAND_FACTOR * hi || (lo > 0.0 && model_rad < lo / LOSS_BAND_FACTOR)
+}
+
+/// The bands where `ext` (the model with a term) contradicts the measured loss per cycle and
+/// `cur` (the model without it) did not, or was closer: the term's own contradiction.
+fn loss_contradictions(env: &EnvelopeFit, cur: &ModelFit, ext: &ModelFit, z: f64) -> Vec<String> {
+    loss_bands(env, cur, ext)
+        .iter()
+        .filter(|b| {
+            loss_band_contradicts(b, b.best_model_rad, z)
+                && (!loss_band_contradicts(b, b.base_model_rad, z)
+                    || (b.best_model_rad - b.measured_rad).abs()
+                        > (b.base_model_rad - b.measured_rad).abs())
+        })
+        .map(|b| {
+            format!(
+                "A {:.4}–{:.4} rad: model {:.3e} rad/cycle ({:.1}× the measured {:.3e} ± {:.1e})",
+                b.amplitude_from_rad,
+                b.amplitude_to_rad,
+                b.best_model_rad,
+                b.best_model_rad / b.measured_rad,
+                b.measured_rad,
+                z * b.measured_se_rad
+            )
+        })
+        .collect()
+}
+
+/// What the envelope says about one added term.
+struct EnvelopeSupport {
+    /// The envelope resolves it (interval clear of 0) and its interval overlaps the trajectory
+    /// fit's.
+    agrees: bool,
+    text: String,
+}
+
+/// The envelope's catalogue fit for each added loss term (a dry term stands for the other when
+/// their loss curves cannot be told apart over the amplitudes seen, unless the other is already
+/// in the model or added with it: the envelope's dry loss is then claimed). Empty for a
+/// stiffness.
+fn envelope_support(
+    env: &EnvelopeFit,
+    current: &[Term],
+    add: &[Term],
+    ests: &[Estimate],
+) -> Vec<EnvelopeSupport> {
+    let claimed = |name: &str| current.iter().chain(add).any(|t| t.name() == name);
+    let amps: Vec<f64> = env
+        .rows
+        .iter()
+        .filter_map(|r| r.mid_amplitude_rad)
+        .collect();
+    let curve = |t: Term| -> Vec<f64> { amps.iter().map(|&a| t.loss_per_cycle(a)).collect() };
+    let dry_alike =
+        correlation(&curve(Term::CoulombConstant), &curve(Term::CoulombBearing)) > 0.995;
+    add.iter()
+        .zip(ests)
+        .filter(|(t, _)| **t != Term::Stiffness)
+        .map(|(&t, e)| {
+            let found = env
+                .catalogue
+                .iter()
+                .find(|c| c.name == t.name())
+                .or_else(|| {
+                    env.catalogue.iter().find(|c| {
+                        dry_alike
+                            && t.is_dry()
+                            && c.name.starts_with("coulomb")
+                            && !claimed(&c.name)
+                    })
+                });
+            match found {
+                Some(c) => {
+                    let resolved = c.ci_low > 0.0;
+                    let overlap = c.ci_low <= e.ci_high && e.ci_low <= c.ci_high;
+                    EnvelopeSupport {
+                        agrees: resolved && overlap,
+                        text: format!(
+                            "{} {:.3e} {} ({})",
+                            c.name,
+                            c.estimate,
+                            ci(c.ci_low, c.ci_high),
+                            match (resolved, overlap) {
+                                (true, true) => "resolved, overlaps the trajectory fit",
+                                (true, false) => "resolved, but disagrees with the trajectory fit",
+                                _ => "not resolved",
+                            }
+                        ),
+                    }
+                }
+                None => EnvelopeSupport {
+                    agrees: false,
+                    text: format!("{} not in its best catalogue subset", t.name()),
+                },
+            }
+        })
+        .collect()
 }
 
 /// Held-out residuals of one model.
@@ -2149,10 +2652,12 @@ fn loss_bands(env: &EnvelopeFit, base: &ModelFit, best: &ModelFit) -> Vec<LossBa
                 best_terms: best
                     .term_list
                     .iter()
+                    .filter(|&&t| t != Term::Stiffness)
                     .map(|&t| {
                         (
                             t.name().to_string(),
-                            best.term_value(t) * t.loss_per_cycle(a),
+                            best.term_value(t)
+                                * t.loss_per_cycle_with(a, best.term_value(Term::Stiffness)),
                         )
                     })
                     .collect(),
@@ -2212,14 +2717,16 @@ fn unexplained(
 ) -> Result<Vec<Unexplained>, DecayError> {
     let mut out = Vec::new();
     let tps = &d.tps;
-    let w = best.omega_n();
+    // The model's time scale (ω_g: gravity's share when a stiffness is in the model).
+    let w = best.omega_g();
+    let kappa = best.term_value(Term::Stiffness);
     // 1. Half period against the exact pendulum period at each half swing's amplitude.
     let swings: Vec<(f64, f64, f64)> = tps
         .windows(2)
         .map(|p| {
             let a = 0.5 * (p[0].theta_rad - p[1].theta_rad).abs();
             let tm = p[1].t_s - p[0].t_s;
-            let tmod = half_period_factor(a) / w;
+            let tmod = half_period_units(a, kappa) / w;
             (a, tm / tmod - 1.0, p[0].t_s)
         })
         .collect();
@@ -2240,7 +2747,8 @@ fn unexplained(
         drift_txt.push(format!("A {lo:.4}–{hi:.4} rad: {:+.2} %", 100.0 * mean));
     }
     notes.push(format!(
-        "half period vs the exact pendulum period (sin θ) at the fitted omega_n, by amplitude: {}",
+        "half period vs the exact pendulum period (sin θ{}) at the fitted omega_n, by amplitude: {}",
+        if kappa > 0.0 { " + kappa θ" } else { "" },
         drift_txt.join("; ")
     ));
     // Reference: the largest third of the swings; scatter from successive differences.
@@ -2411,12 +2919,8 @@ fn unexplained(
         .filter_map(|r| Some((r.mid_amplitude_rad?, r.loss_per_cycle_rad?)))
         .collect();
     if pts.len() >= 4 {
-        let pred = |a: f64| -> f64 {
-            best.term_list
-                .iter()
-                .map(|&t| best.term_value(t) * t.loss_per_cycle(a))
-                .sum()
-        };
+        // With the stiffness the model has (the loss curves depend on the potential).
+        let pred = |a: f64| -> f64 { best.loss_per_cycle(a) };
         let res: Vec<f64> = pts.iter().map(|p| p.1 - pred(p.0)).collect();
         let n = res.len() as f64;
         let sd = (res.iter().map(|v| v * v).sum::<f64>() / n).sqrt();
@@ -2540,6 +3044,10 @@ impl fmt::Display for DecayDiagnosis {
                 terms.join(", ")
             )?;
         }
+        if let Some(l) = &self.period_law {
+            writeln!(f, "{}", l.describe())?;
+        }
+        writeln!(f, "decision rule: {DECAY_RULE}")?;
         writeln!(
             f,
             "{:<2} {:<18} {:<34} {:>11} {:>24} {:>6} {:>9} {:>7} {:>9} {:>8}",
@@ -2573,6 +3081,7 @@ impl fmt::Display for DecayDiagnosis {
                 c.delta_bic,
                 if c.accepted { "yes" } else { "no" }
             )?;
+            writeln!(f, "   {}", c.verdict)?;
         }
         for h in &self.heldout {
             writeln!(
@@ -2657,6 +3166,287 @@ mod tests {
                 p.theta_rad
             );
         }
+    }
+
+    /// A free decay from the model's simulator (exact stick/slip), released at rest from
+    /// `theta0` and sampled at `fs_hz`.
+    fn model_decay(
+        d: Dimensionless,
+        omega_g: f64,
+        theta0: f64,
+        duration_s: f64,
+        fs_hz: f64,
+    ) -> (Vec<f64>, Vec<f64>) {
+        let model = Model::with_excitation(d, Excitation::None);
+        let n = (duration_s * fs_hz) as usize;
+        let t: Vec<f64> = (0..n).map(|i| i as f64 / fs_hz).collect();
+        let mut th = Vec::with_capacity(n);
+        integrate(
+            &model,
+            &SimOptions {
+                rtol: 1e-10,
+                atol: 1e-10,
+                ..SimOptions::default()
+            },
+            0.0,
+            [theta0, 0.0],
+            t[n - 1] * omega_g * (1.0 + 1e-12),
+            t.iter().map(|&x| x * omega_g),
+            |s| {
+                th.push(s.theta);
+                ControlFlow::Continue(())
+            },
+        )
+        .unwrap();
+        assert_eq!(th.len(), n);
+        (t, th)
+    }
+
+    /// Issue 16's recording, as a twin: the decay law's viscous ζ = 0.0056 (β = 2ζ = 0.0112)
+    /// and 5·10⁻⁴ rad of dry loss per half cycle (c = 2.5e-4 rad), so the decay is exponential at
+    /// large swings and linear below ~2° (πβA and 4c cross at A = 4c/(πβ) = 0.028 rad);
+    /// ω_n = 6 rad/s, released from 0.35 rad, 90 s at 150 Hz (the thesis' rate), read through a
+    /// 4096-count encoder whose zero creeps ±2 counts (3e-3 rad) over 23 s (a cable relaxing, a
+    /// stand warming: what real records have and twins lack). The creep barely touches the loss
+    /// per cycle (it alternates in sign from maxima to minima) but dominates the held-out
+    /// residuals at the last swings, where the dry loss shows: the held-out rule's noise
+    /// (3.7 %) then exceeds the dry term's effect on E_theta, as on the issue's recording.
+    fn viscous_dry_twin() -> (Vec<f64>, Vec<f64>, f64, f64) {
+        let (beta, c) = (0.0112, 2.5e-4);
+        let d = Dimensionless {
+            beta,
+            c,
+            ..Dimensionless::conservative()
+        };
+        let (t, th) = model_decay(d, 6.0, 0.35, 90.0, 150.0);
+        let q = std::f64::consts::TAU / 4096.0;
+        let th = t
+            .iter()
+            .zip(&th)
+            .map(|(t, v)| {
+                let creep = 3e-3 * (std::f64::consts::TAU * t / 23.0).sin();
+                ((v + creep) / q).floor() * q
+            })
+            .collect();
+        (t, th, beta, c)
+    }
+
+    fn linear_base() -> DecayOptions {
+        // `discover --base linear` on a free decay: viscous in hand, the others screened.
+        DecayOptions {
+            base: vec![Term::ViscousLinear],
+            resolution_rad: Some(std::f64::consts::TAU / 4096.0),
+            ..DecayOptions::default()
+        }
+    }
+
+    /// Issue 16 item 1: the envelope resolves dry friction + viscous with intervals clear of
+    /// zero, so on the linear base the dry term is accepted (it was rejected by a held-out rule
+    /// whose noise exceeded the effect) and viscous is kept, both estimates within their
+    /// intervals of the truth, and the report states the rule and each view's evidence.
+    #[test]
+    fn regression_issue_16_dry_named_with_the_envelope_on_linear_base() {
+        let (t, th, beta, c) = viscous_dry_twin();
+        let d = diagnose_decay(&t, &th, &linear_base()).unwrap();
+        let text = d.to_string();
+        eprintln!("{text}");
+        let env_dry = d
+            .envelope
+            .catalogue
+            .iter()
+            .find(|k| k.name == "coulomb_constant" || k.name == "coulomb_bearing")
+            .unwrap_or_else(|| panic!("the envelope does not see the dry loss:\n{text}"));
+        assert!(env_dry.ci_low > 0.0, "{env_dry:?}");
+        assert!(
+            env_dry.ci_low <= c && c <= env_dry.ci_high,
+            "the envelope's dry loss {env_dry:?} misses the truth {c}"
+        );
+        assert!(
+            d.is_accepted(Term::CoulombConstant),
+            "dry friction not named:\n{text}"
+        );
+        assert_eq!(
+            d.best.terms,
+            ["viscous_linear", "coulomb_constant"],
+            "{text}"
+        );
+        // Viscous kept (its interval clear of 0, which it was not on the issue's recording);
+        // the trajectory fit's dry interval is wide (the creep), the envelope's is not.
+        let e = d.best.params.iter().find(|p| p.name == "beta").unwrap();
+        assert!(e.ci_low > 0.0, "beta's interval includes 0: {e:?}");
+        for (symbol, truth) in [("beta", beta), ("c", c)] {
+            let e = d.best.params.iter().find(|p| p.name == symbol).unwrap();
+            assert!(
+                e.ci_low <= truth && truth <= e.ci_high,
+                "{symbol} = {} [{}, {}] misses the truth {truth}",
+                e.estimate,
+                e.ci_low,
+                e.ci_high
+            );
+        }
+        let cand = d.candidate(Term::CoulombConstant).unwrap();
+        // The held-out rule alone would reject it (the issue's −4.7 % against a noise of 7.1 %):
+        // the envelope's view accepts it.
+        assert!(
+            cand.heldout_gain <= cand.heldout_noise,
+            "the held-out rule alone accepts it here: {}",
+            cand.verdict
+        );
+        assert!(
+            cand.verdict.contains("the envelope resolves it"),
+            "{}",
+            cand.verdict
+        );
+        assert!(cand.verdict.contains("envelope: "), "{}", cand.verdict);
+        assert!(cand.verdict.contains("loss per cycle"), "{}", cand.verdict);
+        assert!(text.contains(DECAY_RULE), "{text}");
+    }
+
+    /// Issue 16 item 1: nothing accepted loses energy per cycle the pendulum does not. Every
+    /// accepted model's loss per cycle stays inside each amplitude band's measured interval
+    /// (mean ± 1.96·se) widened by `LOSS_BAND_FACTOR` = 1.5, and a quadratic drag like the
+    /// issue's false one (α = 0.25, the decay law's ~0.003 × 100) added to the fitted model is a
+    /// contradiction of its own (it loses several times the measured energy per cycle at the
+    /// large swings), so no held-out gain can make it accepted.
+    #[test]
+    fn regression_issue_16_accepted_loss_within_measured_bands() {
+        let (t, th, _, _) = viscous_dry_twin();
+        let opts = linear_base();
+        let d = diagnose_decay(&t, &th, &opts).unwrap();
+        assert!(d.loss_bands.len() >= 3, "{d}");
+        for b in &d.loss_bands {
+            eprintln!(
+                "A {:.4}–{:.4}: measured {:.3e} ± {:.1e}, best {:.3e}",
+                b.amplitude_from_rad,
+                b.amplitude_to_rad,
+                b.measured_rad,
+                opts.z * b.measured_se_rad,
+                b.best_model_rad
+            );
+            assert!(
+                !loss_band_contradicts(b, b.best_model_rad, opts.z),
+                "the accepted model {:?} contradicts the band {b:?}",
+                d.best.terms
+            );
+        }
+        for c in d.candidates.iter().filter(|c| c.accepted) {
+            assert!(!c.verdict.contains("contradicts"), "{}", c.verdict);
+        }
+        let mut false_drag = d.best.clone();
+        false_drag.term_list.push(Term::ViscousQuadratic);
+        false_drag.x.push(0.25);
+        let bad = loss_contradictions(&d.envelope, &d.best, &false_drag, opts.z);
+        eprintln!("{bad:?}");
+        assert!(
+            !bad.is_empty(),
+            "a quadratic drag of 0.25 passes the loss check"
+        );
+        let worst = loss_bands(&d.envelope, &d.best, &false_drag)
+            .iter()
+            .map(|b| b.best_model_rad / b.measured_rad)
+            .fold(0.0, f64::max);
+        assert!(
+            worst > 3.0,
+            "the false drag loses only {worst:.2}× the measured"
+        );
+    }
+
+    /// A free decay θ'' = −ω_g² sin θ − (k/I) θ − γ θ' by classical RK4 (its own integrator, not
+    /// the model's: the reference for the stiffness test), 10 steps per sample at `fs_hz`,
+    /// read through a 4096-count encoder.
+    fn rk4_spring_decay(
+        omega_g: f64,
+        k_over_i: f64,
+        gamma: f64,
+        theta0: f64,
+        duration_s: f64,
+        fs_hz: f64,
+    ) -> (Vec<f64>, Vec<f64>) {
+        let f =
+            |th: f64, w: f64| -> f64 { -omega_g * omega_g * th.sin() - k_over_i * th - gamma * w };
+        let q = std::f64::consts::TAU / 4096.0;
+        let n = (duration_s * fs_hz) as usize;
+        let h = 1.0 / (10.0 * fs_hz);
+        let (mut th, mut w) = (theta0, 0.0);
+        let mut t_out = Vec::with_capacity(n);
+        let mut th_out = Vec::with_capacity(n);
+        for i in 0..n {
+            t_out.push(i as f64 / fs_hz);
+            th_out.push((th / q).floor() * q);
+            for _ in 0..10 {
+                let (k1t, k1w) = (w, f(th, w));
+                let (k2t, k2w) = (w + 0.5 * h * k1w, f(th + 0.5 * h * k1t, w + 0.5 * h * k1w));
+                let (k3t, k3w) = (w + 0.5 * h * k2w, f(th + 0.5 * h * k2t, w + 0.5 * h * k2w));
+                let (k4t, k4w) = (w + h * k3w, f(th + h * k3t, w + h * k3w));
+                th += h / 6.0 * (k1t + 2.0 * k2t + 2.0 * k3t + k4t);
+                w += h / 6.0 * (k1w + 2.0 * k2w + 2.0 * k3w + k4w);
+            }
+        }
+        (t_out, th_out)
+    }
+
+    #[test]
+    fn half_period_with_stiffness() {
+        for a in [0.01, 0.5, 1.5, 2.5] {
+            assert!((half_period_units(a, 0.0) - half_period_mix(a, 1.0)).abs() < 1e-9);
+            assert!((half_period_mix(a, 0.0) - std::f64::consts::PI).abs() < 1e-9);
+        }
+        // Small swings: π/√(1 + κ) in units of 1/ω_g.
+        let k = 3.0;
+        assert!((half_period_units(1e-4, k) - std::f64::consts::PI / 2.0).abs() < 1e-6);
+    }
+
+    /// Issue 16 item 5: a pendulum with a torsion spring as stiff as gravity (κ = k/(m g a) = 1,
+    /// so half its small-swing stiffness is the spring's), and one dominated by its spring
+    /// (κ = 5), released from 1.2 rad: the period lengthens with amplitude 1/(1 + κ) as much as
+    /// gravity alone would make it, the stiffness is named with κ within 10 %, and the period
+    /// drift it left unexplained is gone. A plain gravity pendulum
+    /// (the same run without the spring) gets nothing named, the stiffness not even tried.
+    #[test]
+    fn regression_issue_16_torsion_spring_named_as_stiffness() {
+        let (omega_g, gamma) = (5.0, 0.08);
+        let opts = DecayOptions {
+            resolution_rad: Some(std::f64::consts::TAU / 4096.0),
+            ..DecayOptions::default()
+        };
+        for kappa in [1.0, 5.0] {
+            let (t, th) =
+                rk4_spring_decay(omega_g, kappa * omega_g * omega_g, gamma, 1.2, 30.0, 200.0);
+            let d = diagnose_decay(&t, &th, &opts).unwrap();
+            let text = d.to_string();
+            eprintln!("{text}");
+            let law = d.period_law.as_ref().expect("no period law");
+            assert!(law.departs, "{}", law.describe());
+            assert!(
+                d.is_accepted(Term::Stiffness),
+                "stiffness not named:\n{text}"
+            );
+            let k_est = d.best.term_value(Term::Stiffness);
+            assert!(
+                (k_est / kappa - 1.0).abs() < 0.10,
+                "kappa {k_est} vs the truth {kappa}"
+            );
+            let wn = omega_g * (1.0 + kappa).sqrt();
+            assert!(
+                (d.best.omega_n() / wn - 1.0).abs() < 0.01,
+                "{} vs {wn}",
+                d.best.omega_n()
+            );
+            // Nothing left over: no period drift, and the loss per cycle of the spring-loaded
+            // potential (not gravity's) matches the envelope.
+            assert!(d.unexplained.is_empty(), "{:?}", d.unexplained);
+        }
+
+        let (t, th) = rk4_spring_decay(omega_g, 0.0, gamma, 1.2, 30.0, 200.0);
+        let d = diagnose_decay(&t, &th, &opts).unwrap();
+        let text = d.to_string();
+        eprintln!("{text}");
+        assert!(d.accepted.is_empty(), "named {:?}:\n{text}", d.accepted);
+        assert!(
+            !d.candidates.iter().any(|c| c.term == "stiffness"),
+            "stiffness tried on a gravity pendulum:\n{text}"
+        );
+        assert!(!d.period_law.as_ref().is_some_and(|l| l.departs), "{text}");
     }
 
     /// Issue 16 item 2: a 12-bit encoder logged in degrees to 0.01° (steps of 0.08° and 0.09°,

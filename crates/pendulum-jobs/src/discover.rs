@@ -635,6 +635,8 @@ fn decay_terms(base: Base) -> (Vec<pendulum_explain::Term>, Vec<pendulum_explain
         Term::ViscousLinear,
         Term::ViscousQuadratic,
         Term::CoulombBearing,
+        // Tried only where the period does not follow the gravity law (issue 16 item 5).
+        Term::Stiffness,
     ]
     .into_iter()
     .filter(|t| !base_terms.contains(t))
@@ -909,6 +911,8 @@ fn term_si(t: pendulum_explain::Term, rig: &pendulum_process::RigParams) -> (f64
         Term::ViscousQuadratic => (f[1], "kg/m"),
         Term::CoulombBearing => (f[2], "1"),
         Term::CoulombConstant => (f[4], "N·m"),
+        // κ = k/(m g l): a torque per radian, scaled as the torques are.
+        Term::Stiffness => (f[4], "N·m/rad"),
     }
 }
 

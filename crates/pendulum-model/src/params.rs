@@ -194,6 +194,7 @@ impl Physical {
             // dω/dt = 2π (dΩ/dτ) / ω0²: Hz/s → (rad per dimensionless time) per dimensionless time.
             omega_drift: 2.0 * std::f64::consts::PI * e.speed_drift_hz_per_s.unwrap_or(0.0)
                 / (w0 * w0),
+            kappa: 0.0,
         }
     }
 
@@ -265,6 +266,10 @@ pub struct Dimensionless {
     pub base_load: bool,
     /// Crank speed drift dω/dt in dimensionless units.
     pub omega_drift: f64,
+    /// Linear restoring stiffness κ = k/(m g l) of a torque −k θ besides gravity (a torsion
+    /// spring, a cable): free decays of spring-loaded pendulums (issue 16). Absent = 0.
+    #[serde(default)]
+    pub kappa: f64,
 }
 
 impl Default for Dimensionless {
@@ -291,6 +296,7 @@ impl Dimensionless {
             j: 0.0,
             base_load: false,
             omega_drift: 0.0,
+            kappa: 0.0,
         }
     }
 
@@ -314,6 +320,7 @@ impl Dimensionless {
             ("M", self.m_coulomb, self.m_coulomb >= 0.0),
             ("c", self.c, self.c >= 0.0),
             ("j", self.j, self.j > -1.0),
+            ("kappa", self.kappa, self.kappa >= 0.0),
         ];
         for (name, v, ok) in checks {
             if !(v.is_finite() && ok) {

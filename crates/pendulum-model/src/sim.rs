@@ -82,6 +82,7 @@ impl Model {
         if p.p != 0.0 {
             q -= p.p * (p.k as f64 * theta + p.phi_p).sin();
         }
+        q -= p.kappa * theta;
         let load = if p.base_load {
             ((1.0 + ay) * c - ax * s).abs()
         } else {
@@ -110,6 +111,7 @@ impl Model {
         if p.p != 0.0 {
             q -= p.p * (p.k as f64 * theta + p.phi_p).sin();
         }
+        q -= p.kappa * theta;
         if p.j != 0.0 {
             q / (1.0 + p.j)
         } else {
@@ -117,9 +119,10 @@ impl Model {
         }
     }
 
-    /// Mechanical energy per m g l of the unforced pendulum: (1 + j) θ̇²/2 − cos θ.
+    /// Mechanical energy per m g l of the unforced pendulum: (1 + j) θ̇²/2 − cos θ + κθ²/2.
     pub fn energy(&self, theta: f64, theta_dot: f64) -> f64 {
         0.5 * (1.0 + self.params.j) * theta_dot * theta_dot - theta.cos()
+            + 0.5 * self.params.kappa * theta * theta
     }
 }
 
