@@ -403,6 +403,28 @@ fn issue_13_an_output_never_overwrites_an_input() {
         tiny_capture()
     );
 
+    // discover with OUT = the campaign folder, where a capture is named like a report.
+    let camp3 = root.path().join("camp3");
+    std::fs::create_dir_all(&camp3).unwrap();
+    std::fs::write(camp3.join("report.md"), tiny_capture()).unwrap();
+    std::fs::write(
+        camp3.join("campaign.toml"),
+        format!("{GOOD_RIG}[[run]]\nid = \"r01\"\nfile = \"report.md\"\nformat = \"serial-v1\"\nrole = \"identify\"\n"),
+    )
+    .unwrap();
+    let o = pendulum()
+        .arg("discover")
+        .arg(&camp3)
+        .arg("--out")
+        .arg(&camp3)
+        .output()
+        .unwrap();
+    assert_refused(&o, "the output", "run r01's capture");
+    assert_eq!(
+        std::fs::read(camp3.join("report.md")).unwrap(),
+        tiny_capture()
+    );
+
     // synth: a case file in OUT under a name the twin writes.
     let out = root.path().join("twin");
     std::fs::create_dir_all(&out).unwrap();

@@ -12,7 +12,7 @@ use pendulum_process::Role;
 use pendulum_report::{Column, ColumnData};
 use serde::{Deserialize, Serialize};
 
-use crate::outputs::write_outputs;
+use crate::outputs::write_outputs_checked;
 use crate::runs::load_runs_resolved;
 use crate::JobError;
 
@@ -129,6 +129,17 @@ pub fn diagnosis_table(d: &Discovery) -> String {
     t
 }
 
+/// What `discover` writes besides identify's tables ([`crate::outputs::TABLES`]) and plots
+/// named after models and runs; checked against the inputs before any work.
+pub const OUTPUTS: [&str; 6] = [
+    "diagnosis.parquet",
+    "signatures.parquet",
+    "envelopes.parquet",
+    "report.md",
+    "signatures.png",
+    "envelopes.png",
+];
+
 pub fn run(job: &DiscoverJob) -> Result<DiscoverSummary, JobError> {
     let started = Instant::now();
     let mut pipe = load(job.pipeline.as_deref())?;
@@ -156,6 +167,15 @@ pub fn run(job: &DiscoverJob) -> Result<DiscoverSummary, JobError> {
     };
     // OUT checked writable (and swept of stale temporary files) before the fits, not after.
     let removed = crate::outputs::prepare_out_dir(&job.out)?;
+    // No output may replace an input (a capture or MCAP in OUT under an output's name).
+    let mut inputs = crate::inputs::Inputs::new();
+    inputs.add_run_source(&job.input)?;
+    if let Some(p) = &job.pipeline {
+        inputs.add("the pipeline file", p);
+    }
+    for name in crate::outputs::TABLES.iter().chain(&OUTPUTS) {
+        inputs.check_output("the output", &job.out.join(name))?;
+    }
     let (runs, steps): (Vec<_>, Vec<_>) = load_runs_resolved(&job.input)?.into_iter().unzip();
     if !runs.is_empty() && runs.iter().all(|r| r.rig.omega_hz.is_none()) {
         return free_decays(job, &runs, &steps, &pipeline_json);
@@ -198,12 +218,13 @@ pub fn run(job: &DiscoverJob) -> Result<DiscoverSummary, JobError> {
             .push((ext.spec.name.clone(), d.validation_final.clone()));
     }
     let out = &job.out;
-    let mut summary = write_outputs(
+    let mut summary = write_outputs_checked(
         &ctx,
         out,
         &pipeline_json,
         "pendulum discover",
         started.elapsed().as_secs_f64(),
+        &inputs,
     )?;
     let opts = pendulum_report::TableOptions::new()
         .meta("command", "pendulum discover")
