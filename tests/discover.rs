@@ -566,6 +566,20 @@ fn survey_issue_5_every_effect() {
     );
 }
 
+/// `discover` on a free-decay campaign with the pipeline's defaults.
+fn discover_free_decays(camp: &Path, out: &Path, base: Base) -> DiscoverSummary {
+    run(&DiscoverJob {
+        input: camp.to_path_buf(),
+        out: out.to_path_buf(),
+        base,
+        pipeline: None,
+        generations: None,
+        seed: None,
+        progress: false,
+    })
+    .unwrap()
+}
+
 /// A free decay of `phys` (no shaker) released at rest from `theta0`, sampled at 200 Hz for
 /// `duration_s`: (t s, θ rad), from the model's own simulator.
 fn free_decay(
@@ -698,16 +712,7 @@ fn regression_issue_16_quantised_decay_stops_at_three_counts() {
     ));
     toml.push_str(&quantised_decay_run(&camp, 1602, "degrees", cprs[1], "deg"));
     std::fs::write(camp.join("campaign.toml"), toml).unwrap();
-    let s = run(&DiscoverJob {
-        input: camp,
-        out: dir.path().join("out"),
-        base: Base::Linear,
-        pipeline: None,
-        generations: None,
-        seed: None,
-        progress: false,
-    })
-    .unwrap();
+    let s = discover_free_decays(&camp, &dir.path().join("out"), Base::Linear);
     eprintln!("{s}");
     assert_eq!(s.decays.len(), 2);
     for ((id, d), cpr) in s.decays.iter().zip(cprs) {
@@ -771,16 +776,7 @@ fn regression_issue_12_free_decays_honour_base() {
     let camp = dir.path().join("campaign");
     let betas = free_decay_campaign(&camp, 1200, 0.45, 0.15);
     let run_base = |base: Base| {
-        let s = run(&DiscoverJob {
-            input: camp.clone(),
-            out: dir.path().join(base.name()),
-            base,
-            pipeline: None,
-            generations: None,
-            seed: None,
-            progress: false,
-        })
-        .unwrap();
+        let s = discover_free_decays(&camp, &dir.path().join(base.name()), base);
         eprintln!("--- base {}\n{s}", base.name());
         for f in [
             "diagnosis.parquet",
@@ -934,16 +930,7 @@ fn regression_issue_16_discover_linear_base_names_dry_with_viscous() {
         ),
     )
     .unwrap();
-    let s = run(&DiscoverJob {
-        input: camp,
-        out: dir.path().join("out"),
-        base: Base::Linear,
-        pipeline: None,
-        generations: None,
-        seed: None,
-        progress: false,
-    })
-    .unwrap();
+    let s = discover_free_decays(&camp, &dir.path().join("out"), Base::Linear);
     eprintln!("{s}");
     assert_eq!(s.decays.len(), 1);
     let (_, d) = &s.decays[0];
