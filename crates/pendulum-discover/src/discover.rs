@@ -873,11 +873,52 @@ fn moving_runs(runs: &[PreparedRun], ics: &[f64]) -> (Vec<PreparedRun>, Vec<f64>
         return (runs.to_vec(), ics.to_vec());
     }
     (
-        keep.iter().map(|&j| runs[j].clone()).collect(),
+        keep.iter().map(|&j| without_still_tail(&runs[j])).collect(),
         keep.iter()
             .flat_map(|&j| [ics[2 * j], ics[2 * j + 1]])
             .collect(),
     )
+}
+
+/// Encoder steps within which a run's angle stays over its still tail (the count flickering
+/// between two neighbours at rest).
+const STILL_TAIL_STEPS: f64 = 2.0;
+
+/// `run` with its window ending where the pendulum comes to rest for good (its angle then stays
+/// within [`STILL_TAIL_STEPS`] encoder steps to the end). A segment restarted at rest from the
+/// measured angle tells a dry friction's size only through whether that quantised angle lies
+/// inside the model's sticking zone, whose edge is a fraction of a degree away: a measured rest
+/// angle rounded outward makes the true friction slide a few mrad in every 0.5 s segment of the
+/// tail, and a larger one stick (a hidden bearing_load_base_accel with μ = 0.1525 was refitted
+/// at 0.190 on a drawn design, ten still segments of one run deciding it). The motion before
+/// the rest, including the stop itself, stays.
+fn without_still_tail(run: &PreparedRun) -> PreparedRun {
+    let step = run
+        .theta
+        .windows(2)
+        .map(|w| (w[1] - w[0]).abs())
+        .filter(|d| *d > 1e-12)
+        .fold(f64::INFINITY, f64::min);
+    if !step.is_finite() || run.theta.is_empty() {
+        return run.clone();
+    }
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    let mut start = run.theta.len();
+    for (i, &v) in run.theta.iter().enumerate().rev() {
+        lo = lo.min(v);
+        hi = hi.max(v);
+        if hi - lo > STILL_TAIL_STEPS * step + 1e-12 {
+            break;
+        }
+        start = i;
+    }
+    // Keep the first sample at rest: the stop itself is motion the model must reproduce.
+    let end = (start + 1).min(run.theta.len()).max(2.min(run.theta.len()));
+    let mut out = run.clone();
+    out.t.truncate(end);
+    out.theta.truncate(end);
+    out.restarts.retain(|(i, _)| *i < end);
+    out
 }
 
 /// The damping/effect parameters alone, initial states held at the base fit's; `fixed` holds one
@@ -1005,7 +1046,7 @@ const HELDOUT_Z: f64 = 1.96;
 /// A paired held-out comparison: the fractional fall 1 − Σafter/Σbefore over paired units, and
 /// the noise it must beat, z × its standard error from the spread of the paired differences
 /// (infinite with fewer than three units: nothing can be told apart then).
-fn paired_gain(before: &[f64], after: &[f64]) -> (f64, f64) {
+pub(crate) fn paired_gain(before: &[f64], after: &[f64]) -> (f64, f64) {
     let n = before.len().min(after.len());
     let sb: f64 = before[..n].iter().sum();
     let sa: f64 = after[..n].iter().sum();
@@ -1353,7 +1394,21 @@ pub fn discover(
             g >= -n
         };
         let agree = views_agree(est, 1.96 * se, refit_est, screen_fits_trajectories);
-        let accepted = excludes_zero
+        // A freer shape in the effect's own variable that does clearly better makes the
+        // catalogue entry a partial explanation of a departure it does not describe.
+        let partial = crate::sparse::family_beats_candidate(
+            &view.id_rows,
+            &current_cols,
+            &cols,
+            crate::sparse::family_of(&c.effect),
+        )
+        .filter(|(d, terms)| {
+            *d < crate::sparse::PARTIAL_BIC
+                // The same shape as the candidate's is no freer description.
+                && !terms.is_empty()
+        });
+        let accepted = partial.is_none()
+            && excludes_zero
             && practically_significant(&c.effect, est, jitter_s, bob_inertia)
             && sc.delta_bic < cfg.screen_threshold
             && held_out
@@ -1362,6 +1417,22 @@ pub fn discover(
         // A clear departure that the best candidate fits only with an impossible value is real
         // and unnamed. (A candidate the refit merely does not confirm is weak evidence, not a
         // departure: it is refused in its row.)
+        if let Some((d, terms)) = partial
+            .as_ref()
+            .filter(|_| excludes_zero && sc.delta_bic < cfg.screen_threshold && possible)
+        {
+            let names: Vec<&str> = terms
+                .iter()
+                .map(|&j| crate::sparse::LIBRARY[j].name)
+                .collect();
+            refused = Some(format!(
+                "the best catalogue candidate, {} (ΔBIC {:.1}), explains the departure only in \
+                 part: a freer shape in the same variable ({}) does better by ΔBIC {d:.1}",
+                c.effect,
+                sc.delta_bic,
+                names.join(" + "),
+            ));
+        }
         if excludes_zero && sc.delta_bic < cfg.screen_threshold && !possible {
             refused = Some(format!(
                 "the best catalogue candidate, {} (ΔBIC {:.1}), fits the departure only with a \
@@ -1401,6 +1472,8 @@ pub fn discover(
                 },
                 if !possible {
                     "; outside its physical range: not accepted"
+                } else if partial.is_some() {
+                    "; a freer shape in the same variable explains the departure better: a partial explanation, not named"
                 } else if !practically_significant(&c.effect, est, jitter_s, bob_inertia) {
                     "; within the rig's own tolerance (encoder zeroing, the stamps' timing jitter, or the inertia the point-mass bob leaves out): not named"
                 } else if !agree {
@@ -1530,9 +1603,29 @@ pub fn discover(
             }
         }
     }
-    let structure = worst.map(|(name, f, p)| {
-        format!("the remaining equation error varies with {name} (F = {f:.1}, p = {p:.1e} over 12 bins)")
-    });
+    // A generic sparse description of what remains, judged on the validate rows like a
+    // catalogue effect; the catalogue model's own columns are refitted along with it.
+    let description = {
+        let nuisance: Vec<Vec<f64>> = view
+            .weak
+            .iter()
+            .map(|r| current_cols.iter().map(|&c| r.x[c]).collect())
+            .collect();
+        let lib: Vec<Vec<f64>> = view.weak.iter().map(|r| r.lib.clone()).collect();
+        let centre: Vec<_> = view
+            .weak
+            .iter()
+            .map(|r| crate::sparse::library_values(r.theta, r.theta_dot_rad_s, r.phase, r.tau_s))
+            .collect();
+        crate::sparse::describe(&view.weak, &final_res, &lib, &nuisance, &id_mask, &centre)
+            .filter(|d| d.heldout_gain > cfg.eq_gain_min.max(d.heldout_noise))
+    };
+    let structure = match &description {
+        Some(d) => Some(d.words(&|r| view.weak_runs[r].0.clone())),
+        None => worst.map(|(name, f, p)| {
+            format!("the remaining equation error varies with {name} (F = {f:.1}, p = {p:.1e} over 12 bins)")
+        }),
+    };
     let unexplained = match (refused, structure) {
         (Some(r), Some(s)) => Some(format!("{r}; {s}")),
         (Some(r), None) => Some(r),

@@ -4,6 +4,7 @@
 
 pub mod discover;
 pub mod screen;
+pub mod sparse;
 pub mod weak;
 
 pub use discover::{discover, DiagnosisRow, DiscoverConfig, Discovery};

@@ -454,6 +454,7 @@ mod tests {
             x,
             weight: 1.0,
             bob_inertia_kg_m2: bob,
+            lib: Vec::new(),
         }
     }
 

@@ -103,6 +103,10 @@ pub struct WeakRow {
     /// The run's bob inertia m l², kg·m²: extra inertia J divides its dynamics by 1 + J/(m l²).
     #[serde(default = "nan")]
     pub bob_inertia_kg_m2: f64,
+    /// The generic library of [`crate::sparse::LIBRARY`], each ∫K·f over the window times the
+    /// run's 1/(m g l): coefficients are torques, N·m per unit of f.
+    #[serde(default)]
+    pub lib: Vec<f64>,
 }
 
 fn nan() -> f64 {
@@ -271,6 +275,7 @@ pub fn weak_rows(run_idx: usize, run: &RunData, al: &Alignment, cfg: &WeakConfig
     let omega_dot = 2.0 * std::f64::consts::PI * al.speed_drift_hz_per_s / (w0 * w0);
     let r_over_l = run.rig.crank_r_m / run.rig.l_m;
     let factors = si_factors(&run.rig);
+    let torque_factor = 1.0 / (run.rig.m_kg * run.rig.g_m_s2 * run.rig.l_m);
     // Forcing in the aligned dimensionless time (φ = ωt + ½ω̇t²), and its rate.
     let ay_at = |tt: f64| -> (f64, f64) {
         let phi = omega * tt + 0.5 * omega_dot * tt * tt;
@@ -342,6 +347,7 @@ pub fn weak_rows(run_idx: usize, run: &RunData, al: &Alignment, cfg: &WeakConfig
             }
             let mut target = 0.0;
             let mut x = vec![0.0; TERMS.len() + 1];
+            let mut lib = vec![0.0; crate::sparse::LIBRARY.len()];
             let th_c = grid[c].unwrap_or(0.0);
             let dtt = dt * w0; // dimensionless step
             for i in range.clone() {
@@ -355,11 +361,12 @@ pub fn weak_rows(run_idx: usize, run: &RunData, al: &Alignment, cfg: &WeakConfig
                 let th_i = grid[i].unwrap_or(0.0);
                 let w = thd[i].unwrap_or(0.0) / w0;
                 let tau = a + i as f64 * dt;
-                let (ay, ay_dot, _) = if forced {
+                let (ay, ay_dot, phase_i) = if forced {
                     forcing(tau)
                 } else {
-                    (0.0, 0.0, 0.0)
+                    (0.0, 0.0, f64::NAN)
                 };
+
                 let (sn, cs) = th_i.sin_cos();
                 let sg = if w > 0.0 {
                     1.0
@@ -369,6 +376,10 @@ pub fn weak_rows(run_idx: usize, run: &RunData, al: &Alignment, cfg: &WeakConfig
                     0.0
                 };
                 let kk = k * wgt * dtt;
+                let lv = crate::sparse::library_values(th_i, w * w0, phase_i, tau);
+                for (li, v) in lib.iter_mut().zip(lv) {
+                    *li += kk * v * torque_factor;
+                }
                 // ∫K''θ dt with d²/dt² = (1/h²) d²/ds², about the window's centre value: ∫K'' = 0
                 // exactly, but not its discrete sum, which would multiply a rotating run's
                 // unwrapped angle (tens of rad) into the result.
@@ -426,6 +437,7 @@ pub fn weak_rows(run_idx: usize, run: &RunData, al: &Alignment, cfg: &WeakConfig
                 x,
                 weight: 1.0,
                 bob_inertia_kg_m2: run.rig.m_kg * run.rig.l_m * run.rig.l_m,
+                lib,
             });
             c += 2 * half;
         }
@@ -541,6 +553,7 @@ mod contrast_tests {
             x,
             weight: 1.0,
             bob_inertia_kg_m2: 0.1,
+            lib: Vec::new(),
         }
     }
 

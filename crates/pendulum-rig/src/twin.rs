@@ -68,6 +68,24 @@ pub struct TwinTruth {
     pub mu: f64,
     #[serde(default)]
     pub effects: Effects,
+    /// Departures outside the catalogue (effects.md, last paragraph), for tests of an honest
+    /// `unexplained`: the analysis has no name for them.
+    #[serde(default)]
+    pub departures: Departures,
+}
+
+/// What a real rig can hold that no catalogue entry describes.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Departures {
+    /// A linear torsion spring (a cable) adding −k θ about the hanging position, θ unwrapped,
+    /// N·m/rad.
+    #[serde(default)]
+    pub torsion_spring_nm_per_rad: Option<f64>,
+    /// The encoder's real counts per revolution while its header says 4096 (a mislabelled
+    /// encoder).
+    #[serde(default)]
+    pub encoder_cpr_true: Option<f64>,
 }
 
 /// Sensor and firmware imperfections (`rig.md`); defaults are the rig's typical values.
@@ -436,7 +454,10 @@ fn synthesize_run(
         expected,
     };
     phys.validate().map_err(|e| bad(e.to_string()))?;
-    let d = phys.to_dimensionless();
+    let mut d = phys.to_dimensionless();
+    if let Some(k) = case.truth.departures.torsion_spring_nm_per_rad {
+        d.kappa = k / (phys.m_kg * phys.g_m_s2 * phys.l_m);
+    }
     let w0 = phys.omega0_rad_s();
     // Dimensionless time of the shaker start and of being at speed.
     let t_start = run.free_s * w0;
@@ -634,9 +655,10 @@ fn synthesize_run(
         0
     };
     let theta_off = phys.effects.encoder_offset_rad.unwrap_or(0.0);
+    let cpr_true = case.truth.departures.encoder_cpr_true.unwrap_or(4096.0);
     let counts: Vec<i64> = theta
         .iter()
-        .map(|&th| (4096.0 * (th + theta_off) / two_pi).floor() as i64 + zero_err)
+        .map(|&th| (cpr_true * (th + theta_off) / two_pi).floor() as i64 + zero_err)
         .collect();
     let clock_start = run.clock_start_us.unwrap_or_else(|| rng.random::<u32>());
     let stamp = |t: f64| -> u32 { clock_start.wrapping_add((t * 1e6).round() as u64 as u32) };
