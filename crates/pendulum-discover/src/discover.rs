@@ -131,6 +131,9 @@ pub struct Discovery {
     pub validation_final: Vec<RunFit>,
     /// Where unexplained structure lives, if any.
     pub unexplained: Option<String>,
+    /// The generic sparse description behind `unexplained`, when it has one (its terms,
+    /// variable, size, held-out gain).
+    pub unexplained_description: Option<crate::sparse::Description>,
     /// Shaker runs whose accelerometer the crank-rod model does not explain (tracked residual
     /// over [`pendulum_process::align::FORCING_MISFIT_RATIO`] × the sensor's noise): their
     /// forced segments and crank fits were left out, with the residual and the noise, m/s².
@@ -1391,7 +1394,22 @@ pub fn discover(
                 None => x0.clone(),
             };
             let (g, n) = trajectory_substitution(&traj_runs, &spec, &x, &x_prof, &traj_ics);
-            g >= -n
+            // "Not significantly worse" confirms the screen's value only where the trajectories
+            // can tell the effect from its absence at all: through chaos they often cannot, and
+            // a 0.020 kg·m² "extra inertia" (the refit: 0.00045) that stood in for a
+            // mislabelled encoder passed a profile test with no power. (The bearing load's μ
+            // has no absence to compare with.)
+            let informative = match i {
+                Some(i) if c.effect != "bearing_load_base_accel" => {
+                    let mut x_zero = x.clone();
+                    x_zero[i] = 0.0;
+                    let (g0, n0) =
+                        trajectory_substitution(&traj_runs, &spec, &x, &x_zero, &traj_ics);
+                    g0 < -n0
+                }
+                _ => true,
+            };
+            g >= -n && informative
         };
         let agree = views_agree(est, 1.96 * se, refit_est, screen_fits_trajectories);
         // A freer shape in the effect's own variable that does clearly better makes the
@@ -1615,14 +1633,36 @@ pub fn discover(
         let centre: Vec<_> = view
             .weak
             .iter()
-            .map(|r| crate::sparse::library_values(r.theta, r.theta_dot_rad_s, r.phase, r.tau_s))
+            .map(|r| {
+                // The measured acceleration in g (the library's A_y; 0 in the free segment).
+                let a_y = if r.a_y_meas.is_finite() && r.phase.is_finite() {
+                    r.a_y_meas / pendulum_model::params::G_STANDARD_M_S2
+                } else {
+                    0.0
+                };
+                crate::sparse::library_values(r.theta, r.theta_dot_rad_s, r.phase, r.tau_s, a_y)
+            })
             .collect();
         crate::sparse::describe(&view.weak, &final_res, &lib, &nuisance, &id_mask, &centre)
-            .filter(|d| d.heldout_gain > cfg.eq_gain_min.max(d.heldout_noise))
     };
-    let structure = match &description {
-        Some(d) => Some(d.words(&|r| view.weak_runs[r].0.clone())),
-        None => worst.map(|(name, f, p)| {
+    let confirmed_description = description
+        .as_ref()
+        .filter(|d| d.heldout_gain > cfg.eq_gain_min.max(d.heldout_noise));
+    // The description the words below use, if any.
+    let described = match (confirmed_description, &description) {
+        (Some(d), _) => Some(d.clone()),
+        (None, Some(d)) if refused.is_some() => Some(d.clone()),
+        _ => None,
+    };
+    let structure = match (confirmed_description, &description) {
+        (Some(d), _) => Some(d.words(&|r| view.weak_runs[r].0.clone())),
+        // A refused candidate already says a departure is there; describe it even where the
+        // validate runs cannot confirm the description's shape, and say so.
+        (None, Some(d)) if refused.is_some() => Some(format!(
+            "{} (the validate runs do not confirm this shape)",
+            d.words(&|r| view.weak_runs[r].0.clone())
+        )),
+        _ => worst.map(|(name, f, p)| {
             format!("the remaining equation error varies with {name} (F = {f:.1}, p = {p:.1e} over 12 bins)")
         }),
     };
@@ -1681,6 +1721,7 @@ pub fn discover(
         weak_runs: view0.weak_runs,
         residual_base,
         residual_final,
+        unexplained_description: unexplained.as_ref().and(described),
         unexplained,
         forcing_not_understood: ctx
             .runs

@@ -53,31 +53,112 @@ pub struct Term {
 }
 
 /// The library, in the order of [`library_values`].
-pub const LIBRARY: [Term; 21] = [
-    t("θ̇", Variable::Rate, "linear in dθ/dt (a viscous-like torque)", "rad/s"),
+pub const LIBRARY: [Term; 22] = [
+    t(
+        "θ̇",
+        Variable::Rate,
+        "linear in dθ/dt (a viscous-like torque)",
+        "rad/s",
+    ),
     t("θ̇|θ̇|", Variable::Rate, "quadratic in dθ/dt", "(rad/s)²"),
     t("θ̇³", Variable::Rate, "cubic in dθ/dt", "(rad/s)³"),
     t("sgn θ̇", Variable::Rate, "a step at dθ/dt = 0", "1"),
-    t("|θ̇|", Variable::Rate, "even in dθ/dt (the same sign both ways)", "rad/s"),
-    t("θ", Variable::Angle, "linear in the unwrapped θ (a spring)", "rad"),
+    t(
+        "|θ̇|",
+        Variable::Rate,
+        "even in dθ/dt (the same sign both ways)",
+        "rad/s",
+    ),
+    t(
+        "θ",
+        Variable::Angle,
+        "linear in the unwrapped θ (a spring)",
+        "rad",
+    ),
     t("θ³", Variable::Angle, "cubic in the unwrapped θ", "rad³"),
-    t("sin θ", Variable::AngleInTurn, "periodic in θ with 1 lobe", "1"),
-    t("cos θ", Variable::AngleInTurn, "periodic in θ with 1 lobe", "1"),
-    t("sin 2θ", Variable::AngleInTurn, "periodic in θ with 2 lobes", "1"),
-    t("cos 2θ", Variable::AngleInTurn, "periodic in θ with 2 lobes", "1"),
-    t("sin 3θ", Variable::AngleInTurn, "periodic in θ with 3 lobes", "1"),
-    t("cos 3θ", Variable::AngleInTurn, "periodic in θ with 3 lobes", "1"),
-    t("sin 4θ", Variable::AngleInTurn, "periodic in θ with 4 lobes", "1"),
-    t("cos 4θ", Variable::AngleInTurn, "periodic in θ with 4 lobes", "1"),
+    t(
+        "(1 + A_y) θ cos θ",
+        Variable::Angle,
+        "a gravity torque out of step with the measured angle (the angle's scale is off)",
+        "rad",
+    ),
+    t(
+        "sin θ",
+        Variable::AngleInTurn,
+        "periodic in θ with 1 lobe",
+        "1",
+    ),
+    t(
+        "cos θ",
+        Variable::AngleInTurn,
+        "periodic in θ with 1 lobe",
+        "1",
+    ),
+    t(
+        "sin 2θ",
+        Variable::AngleInTurn,
+        "periodic in θ with 2 lobes",
+        "1",
+    ),
+    t(
+        "cos 2θ",
+        Variable::AngleInTurn,
+        "periodic in θ with 2 lobes",
+        "1",
+    ),
+    t(
+        "sin 3θ",
+        Variable::AngleInTurn,
+        "periodic in θ with 3 lobes",
+        "1",
+    ),
+    t(
+        "cos 3θ",
+        Variable::AngleInTurn,
+        "periodic in θ with 3 lobes",
+        "1",
+    ),
+    t(
+        "sin 4θ",
+        Variable::AngleInTurn,
+        "periodic in θ with 4 lobes",
+        "1",
+    ),
+    t(
+        "cos 4θ",
+        Variable::AngleInTurn,
+        "periodic in θ with 4 lobes",
+        "1",
+    ),
     t("sin φ", Variable::Phase, "at the crank frequency", "1"),
     t("cos φ", Variable::Phase, "at the crank frequency", "1"),
-    t("sin 2φ", Variable::Phase, "at twice the crank frequency", "1"),
-    t("cos 2φ", Variable::Phase, "at twice the crank frequency", "1"),
+    t(
+        "sin 2φ",
+        Variable::Phase,
+        "at twice the crank frequency",
+        "1",
+    ),
+    t(
+        "cos 2φ",
+        Variable::Phase,
+        "at twice the crank frequency",
+        "1",
+    ),
     t("t", Variable::Time, "growing with time", "s"),
-    t("t sgn θ̇", Variable::Time, "a friction growing with time", "s"),
+    t(
+        "t sgn θ̇",
+        Variable::Time,
+        "a friction growing with time",
+        "s",
+    ),
 ];
 
-const fn t(name: &'static str, variable: Variable, shape: &'static str, unit: &'static str) -> Term {
+const fn t(
+    name: &'static str,
+    variable: Variable,
+    shape: &'static str,
+    unit: &'static str,
+) -> Term {
     Term {
         name,
         variable,
@@ -87,8 +168,15 @@ const fn t(name: &'static str, variable: Variable, shape: &'static str, unit: &'
 }
 
 /// The library's values at one sample: θ (rad, unwrapped), θ̇ (rad/s), forcing phase (rad, NaN
-/// without forcing: its terms are then 0), time (s from the aligned t = 0).
-pub fn library_values(theta: f64, theta_dot: f64, phase: f64, t_s: f64) -> [f64; LIBRARY.len()] {
+/// without forcing: its terms are then 0), time (s from the aligned t = 0), and the base's
+/// vertical acceleration in g (0 without forcing), which scales gravity.
+pub fn library_values(
+    theta: f64,
+    theta_dot: f64,
+    phase: f64,
+    t_s: f64,
+    a_y: f64,
+) -> [f64; LIBRARY.len()] {
     let sg = if theta_dot > 0.0 {
         1.0
     } else if theta_dot < 0.0 {
@@ -97,7 +185,12 @@ pub fn library_values(theta: f64, theta_dot: f64, phase: f64, t_s: f64) -> [f64;
         0.0
     };
     let (sp, cp, s2p, c2p) = if phase.is_finite() {
-        (phase.sin(), phase.cos(), (2.0 * phase).sin(), (2.0 * phase).cos())
+        (
+            phase.sin(),
+            phase.cos(),
+            (2.0 * phase).sin(),
+            (2.0 * phase).cos(),
+        )
     } else {
         (0.0, 0.0, 0.0, 0.0)
     };
@@ -109,6 +202,7 @@ pub fn library_values(theta: f64, theta_dot: f64, phase: f64, t_s: f64) -> [f64;
         theta_dot.abs(),
         theta,
         theta.powi(3),
+        (1.0 + a_y) * theta * theta.cos(),
         theta.sin(),
         theta.cos(),
         (2.0 * theta).sin(),
@@ -170,11 +264,7 @@ impl Description {
                 )
             })
             .collect();
-        let top = self
-            .per_run_nm
-            .iter()
-            .map(|r| r.1)
-            .fold(0.0_f64, f64::max);
+        let top = self.per_run_nm.iter().map(|r| r.1).fold(0.0_f64, f64::max);
         let runs: Vec<String> = self
             .per_run_nm
             .iter()
@@ -365,7 +455,7 @@ pub fn describe(
 pub fn family_of(effect: &str) -> &'static [Variable] {
     match effect {
         "viscous_linear" | "viscous_quadratic" | "coulomb_constant" => &[Variable::Rate],
-        "position_torque" => &[Variable::Angle, Variable::AngleInTurn],
+        "position_torque" | "extra_inertia" => &[Variable::Angle, Variable::AngleInTurn],
         _ => &[],
     }
 }
@@ -509,7 +599,7 @@ mod tests {
                 2.0 * (0.3 * i as f64).sin()
             };
             let thd = 3.0 * (0.7 * i as f64).cos();
-            let v = library_values(th, thd, f64::NAN, 0.01 * i as f64);
+            let v = library_values(th, thd, f64::NAN, 0.01 * i as f64, 0.0);
             // A deterministic stand-in for uniform noise.
             let e = 0.002 * (((i as f64 * 12.9898).sin() * 43_758.545).fract() - 0.0);
             rows.push(row(run, 1.0));

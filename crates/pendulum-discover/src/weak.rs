@@ -376,7 +376,7 @@ pub fn weak_rows(run_idx: usize, run: &RunData, al: &Alignment, cfg: &WeakConfig
                     0.0
                 };
                 let kk = k * wgt * dtt;
-                let lv = crate::sparse::library_values(th_i, w * w0, phase_i, tau);
+                let lv = crate::sparse::library_values(th_i, w * w0, phase_i, tau, ay);
                 for (li, v) in lib.iter_mut().zip(lv) {
                     *li += kk * v * torque_factor;
                 }

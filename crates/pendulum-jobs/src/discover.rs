@@ -623,6 +623,7 @@ fn free_decays(
             weak_runs: Vec::new(),
             residual_base: Vec::new(),
             residual_final: Vec::new(),
+            unexplained_description: None,
             validation_base: Vec::new(),
             validation_final: Vec::new(),
             unexplained: None,
