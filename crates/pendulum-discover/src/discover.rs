@@ -857,12 +857,7 @@ pub const STILL_SPAN_STEPS: f64 = 10.0;
 /// in run order); all of them if none does.
 fn moving_runs(runs: &[PreparedRun], ics: &[f64]) -> (Vec<PreparedRun>, Vec<f64>) {
     let moving = |r: &PreparedRun| {
-        let step = r
-            .theta
-            .windows(2)
-            .map(|w| (w[1] - w[0]).abs())
-            .filter(|d| *d > 1e-12)
-            .fold(f64::INFINITY, f64::min);
+        let step = quantisation_step(&r.theta);
         let (lo, hi) = r
             .theta
             .iter()
@@ -883,6 +878,16 @@ fn moving_runs(runs: &[PreparedRun], ics: &[f64]) -> (Vec<PreparedRun>, Vec<f64>
     )
 }
 
+/// A measured angle's quantisation step: the smallest non-zero change between samples, rad
+/// (infinite when it never changes).
+fn quantisation_step(theta: &[f64]) -> f64 {
+    theta
+        .windows(2)
+        .map(|w| (w[1] - w[0]).abs())
+        .filter(|d| *d > 1e-12)
+        .fold(f64::INFINITY, f64::min)
+}
+
 /// Encoder steps within which a run's angle stays over its still tail (the count flickering
 /// between two neighbours at rest).
 const STILL_TAIL_STEPS: f64 = 2.0;
@@ -896,12 +901,7 @@ const STILL_TAIL_STEPS: f64 = 2.0;
 /// at 0.190 on a drawn design, ten still segments of one run deciding it). The motion before
 /// the rest, including the stop itself, stays.
 fn without_still_tail(run: &PreparedRun) -> PreparedRun {
-    let step = run
-        .theta
-        .windows(2)
-        .map(|w| (w[1] - w[0]).abs())
-        .filter(|d| *d > 1e-12)
-        .fold(f64::INFINITY, f64::min);
+    let step = quantisation_step(&run.theta);
     if !step.is_finite() || run.theta.is_empty() {
         return run.clone();
     }
