@@ -149,6 +149,33 @@ fn regression_issue_4_reference_damping_recovered() {
             assert_eq!(meas[i], sim[i], "{id}: validate steady state");
         }
     }
+    // residuals.parquet holds the residual the fit minimised (issue 14 item 5): over each run's
+    // `segments` rows, Σ|θ_meas − θ_sim| is that run's E_θ as the fit (identify runs) or the
+    // validation (validate runs) computed it, and every segment restarts near the measurement.
+    let res = out.join("residuals.parquet");
+    let (r_id, r_mode, r_model) = (
+        column_str(&res, "run_id"),
+        column_str(&res, "mode"),
+        column_str(&res, "model"),
+    );
+    let r_err = column_f64(&res, "residual");
+    let e_theta = column_f64(&runs, "e_theta");
+    for (i, id) in ids.iter().enumerate() {
+        let rows: Vec<usize> = (0..r_id.len())
+            .filter(|&k| &r_id[k] == id && r_mode[k] == "segments" && r_model[k] == "reference")
+            .collect();
+        assert!(!rows.is_empty(), "{id}: no `segments` residuals");
+        let sum: f64 = rows.iter().map(|&k| r_err[k].abs()).sum();
+        assert!(
+            (sum - e_theta[i]).abs() <= 0.01 * e_theta[i].max(1e-3),
+            "{id}: Σ|residual| of the segments {sum} vs E_θ {}",
+            e_theta[i]
+        );
+    }
+    assert!(
+        r_mode.iter().any(|m| m == "free_run"),
+        "the free run is the second mode"
+    );
     if python_has("pyarrow") {
         python_check("check_outputs.py", &[&out]);
     }

@@ -12,7 +12,7 @@ SCHEMAS = {
     "initial_conditions.parquet": {"run_id": "string", "model": "string", "theta0_est": "double",
                                    "theta_dot0_est": "double", "theta0_fit": "double",
                                    "theta_dot0_fit": "double"},
-    "residuals.parquet": {"run_id": "string", "model": "string", "role": "string", "t": "double",
+    "residuals.parquet": {"run_id": "string", "model": "string", "role": "string", "mode": "string", "segment": "int64", "t": "double",
                           "tau_s": "double", "theta_meas": "double", "theta_sim": "double",
                           "residual": "double", "theta_dot_meas": "double", "theta_dot_sim": "double"},
     "convergence.parquet": {"generation": "int64", "best": "double", "worst": "double", "mean": "double"},

@@ -192,6 +192,55 @@ pub fn residuals_of(
     Ok(out)
 }
 
+/// The residual each fitted model's fit minimised on every run it saw (identify runs from the
+/// fit, validate runs from the validation): multiple-shooting segments restarted from the
+/// measured state over the fit window, with each sample's segment number.
+pub fn segment_residuals_of(
+    ctx: &Context,
+    fit: &FitOutcome,
+    validation: Option<&[RunFit]>,
+) -> Result<Vec<(String, Role, ResidualSeries, Vec<usize>)>, JobError> {
+    let mut out = Vec::new();
+    let mut all: Vec<&RunFit> = fit.runs.iter().collect();
+    if let Some(v) = validation {
+        all.extend(v.iter());
+    }
+    for rf in all {
+        let Some(run) = ctx.runs.iter().find(|r| r.id == rf.id) else {
+            continue;
+        };
+        let Some(al) = fit
+            .alignments
+            .get(&rf.id)
+            .or_else(|| ctx.alignments.get(&rf.id))
+        else {
+            continue;
+        };
+        // The window the run was fitted or validated with.
+        let window = match rf.role {
+            Role::Identify => ctx.fit_window.clone(),
+            _ => ctx.validate_window.clone(),
+        }
+        .unwrap_or_default();
+        let (Some(ic), Some(steady)) = (ctx.initial.get(&rf.id), ctx.steady.get(&rf.id)) else {
+            continue;
+        };
+        let (series, segments) = pendulum_process::identify::segment_residual_series(
+            run,
+            al,
+            ic,
+            steady,
+            &ctx.steady_cfg,
+            &fit.spec,
+            &fit.params,
+            rf.ic_fit,
+            &window,
+        )?;
+        out.push((rf.id.clone(), rf.role, series, segments));
+    }
+    Ok(out)
+}
+
 /// Runs the identify pipeline and writes the outputs.
 pub fn run(job: &IdentifyJob) -> Result<OutputSummary, JobError> {
     let started = Instant::now();

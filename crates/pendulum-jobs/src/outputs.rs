@@ -19,7 +19,7 @@ use pendulum_process::pipeline::Context;
 use pendulum_process::{RigParams, Role};
 use pendulum_report::{Column, ColumnData, TableOptions};
 
-use crate::identify::residuals_of;
+use crate::identify::{residuals_of, segment_residuals_of};
 use crate::inputs::Inputs;
 use crate::JobError;
 
@@ -625,6 +625,7 @@ pub fn write_outputs_checked(
     let (mut cv_model, mut cv_gen) = (Vec::new(), Vec::new());
     let mut cvv: Vec<Vec<f64>> = vec![Vec::new(); 3];
     let (mut rs_run, mut rs_model, mut rs_role) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut rs_mode, mut rs_segment) = (Vec::new(), Vec::new());
     let mut rsv: Vec<Vec<f64>> = vec![Vec::new(); 7];
     for m in &models {
         let val = validation_of(ctx, &m.spec.name);
@@ -657,11 +658,35 @@ pub fn write_outputs_checked(
             cvv[1].push(w);
             cvv[2].push(mean);
         }
+        // The residual the fit minimised (mode `segments`), then the free run (mode `free_run`).
+        for (id, role, s, segments) in segment_residuals_of(ctx, m, val)? {
+            for k in 0..s.t.len() {
+                rs_run.push(id.clone());
+                rs_model.push(m.spec.name.clone());
+                rs_role.push(role.as_str().to_string());
+                rs_mode.push("segments".to_string());
+                rs_segment.push(segments[k] as i64);
+                let v = [
+                    s.t[k],
+                    s.tau_s[k],
+                    s.theta_meas[k],
+                    s.theta_sim[k],
+                    s.theta_meas[k] - s.theta_sim[k],
+                    s.theta_dot_meas[k],
+                    s.theta_dot_sim[k],
+                ];
+                for (col, x) in rsv.iter_mut().zip(v) {
+                    col.push(x);
+                }
+            }
+        }
         for (id, role, s) in residuals_of(ctx, m, val, 60.0)? {
             for k in 0..s.t.len() {
                 rs_run.push(id.clone());
                 rs_model.push(m.spec.name.clone());
                 rs_role.push(role.as_str().to_string());
+                rs_mode.push("free_run".to_string());
+                rs_segment.push(-1);
                 let v = [
                     s.t[k],
                     s.tau_s[k],
@@ -736,6 +761,8 @@ pub fn write_outputs_checked(
             strs("run_id", rs_run),
             strs("model", rs_model),
             strs("role", rs_role),
+            strs("mode", rs_mode),
+            ints("segment", rs_segment),
         ];
         let names = [
             ("t", "1 (t = ω0·τ)"),

@@ -964,6 +964,62 @@ impl StudyObjective<'_> {
             per_run_sim_steady: steadies,
         }
     }
+
+    /// The residual this objective minimises, sample by sample: every multiple-shooting
+    /// segment simulated as [`Self::evaluate`] does (the first from the run's initial state in
+    /// `x`, later ones restarted from the measured state), per run in time order. A segment whose
+    /// integration fails ends early; its remaining samples are absent.
+    pub fn segment_series(&self, x: &[f64]) -> Vec<Vec<SegmentSample>> {
+        let (p, ics) = self.split(x);
+        let off = self.offset(&p);
+        let mut out: Vec<Vec<SegmentSample>> = vec![Vec::new(); self.runs.len()];
+        let mut seg_no = vec![0usize; self.runs.len()];
+        for g in segments(self.runs) {
+            let run = &self.runs[g.run];
+            let model = self.model_of(run, &p);
+            let k = self.spec.time_scale(run, &p);
+            let y = g.y0.unwrap_or([ics[2 * g.run], ics[2 * g.run + 1]]);
+            let segment = seg_no[g.run];
+            seg_no[g.run] += 1;
+            let rec = &mut out[g.run];
+            let mut j = g.i0;
+            // A failed integration leaves the samples it reached; the rest are absent.
+            let _ = integrate(
+                &model,
+                &SimOptions {
+                    h_init: Some(SEGMENT_H_INIT),
+                    ..self.sim
+                },
+                g.t0 * k,
+                [y[0] - off, y[1] / k],
+                run.t[g.i1 - 1] * k,
+                run.t[g.i0..g.i1].iter().map(|t| t * k),
+                |smp| {
+                    rec.push(SegmentSample {
+                        segment,
+                        index: j,
+                        theta_sim: smp.theta + off,
+                        theta_dot_sim: smp.theta_dot * k,
+                    });
+                    j += 1;
+                    ControlFlow::Continue(())
+                },
+            );
+        }
+        out
+    }
+}
+
+/// One sample of [`StudyObjective::segment_series`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SegmentSample {
+    /// The segment's number within its run (0: from the fitted initial state).
+    pub segment: usize,
+    /// Index of the sample in the run's `t`/`theta`.
+    pub index: usize,
+    /// Simulated θ in measured coordinates (rad) and dθ/dt in the run's time unit.
+    pub theta_sim: f64,
+    pub theta_dot_sim: f64,
 }
 
 impl Problem for StudyObjective<'_> {

@@ -730,6 +730,58 @@ pub fn residual_series(
     Ok(out)
 }
 
+/// The residual the fit minimises over a run's fit window, sample by sample: each
+/// multiple-shooting segment restarted from the measured state (the first from the fitted
+/// initial state `ic_fit`), as the objective evaluates it; with each sample's segment number.
+/// A free-running simulation (see [`residual_series`]) slips whole turns on a rotating run; this
+/// one shows what the fit saw.
+#[allow(clippy::too_many_arguments)]
+pub fn segment_residual_series(
+    run: &RunData,
+    al: &Alignment,
+    ic: &InitialState,
+    steady: &SteadyState,
+    steady_cfg: &SteadyConfig,
+    spec: &ModelSpec,
+    params: &[f64],
+    ic_fit: [f64; 2],
+    window: &Window,
+) -> Result<(ResidualSeries, Vec<usize>), ProcessError> {
+    let prepared = prepare_run(run, al, ic, steady, steady_cfg, window)?;
+    let runs = std::slice::from_ref(&prepared);
+    let objective = StudyObjective {
+        runs,
+        spec,
+        kappa: 1.0,
+        sim: SimOptions::with_tol(1e-6),
+        ic_halfwidth: 0.1,
+        fixed_params: Some(params.to_vec()),
+        penalty: false,
+        order: Default::default(),
+    };
+    let samples = objective.segment_series(&ic_fit).pop().unwrap_or_default();
+    let w0 = prepared.omega0();
+    let ic_cfg = IcConfig::default();
+    let mut out = ResidualSeries::default();
+    let mut segment = Vec::with_capacity(samples.len());
+    for smp in samples {
+        let t = prepared.t[smp.index];
+        let tau = t / w0;
+        out.t.push(t);
+        out.tau_s.push(tau);
+        out.theta_meas.push(prepared.theta[smp.index]);
+        out.theta_sim.push(smp.theta_sim);
+        out.theta_dot_sim.push(smp.theta_dot_sim * w0);
+        out.theta_dot_meas.push(
+            estimate_state(run, al.t0_s + tau, &ic_cfg)
+                .map(|s| s.theta_dot_rad_s)
+                .unwrap_or(f64::NAN),
+        );
+        segment.push(smp.segment);
+    }
+    Ok((out, segment))
+}
+
 /// The simulated steady state of a prepared run from an initial state (for reports).
 pub fn steady_from(
     run: &PreparedRun,

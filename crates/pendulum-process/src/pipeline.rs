@@ -47,6 +47,10 @@ pub struct Context {
     pub progress: Option<ProgressFn>,
     /// Human-readable notes (warnings) the stages leave.
     pub notes: Vec<String>,
+    /// The fit windows the fit and validate stages sampled their runs with (for outputs that
+    /// show the residual the fit minimised).
+    pub fit_window: Option<crate::identify::Window>,
+    pub validate_window: Option<crate::identify::Window>,
 }
 
 impl Context {
@@ -274,6 +278,7 @@ impl Stage for FitStage {
     }
     fn run(&self, ctx: &mut Context) -> Result<(), ProcessError> {
         let runs = ctx.prepared(Role::Identify, &self.0.window, self.name())?;
+        ctx.fit_window = Some(self.0.window.clone());
         let out = identify(&runs, &self.0, ctx.progress.clone())?;
         ctx.notes
             .extend(crate::identify::shared_omega0_notes(&runs, &out));
@@ -292,6 +297,7 @@ impl Stage for ValidateStage {
     }
     fn run(&self, ctx: &mut Context) -> Result<(), ProcessError> {
         let runs = ctx.prepared(Role::Validate, &self.0.window, self.name())?;
+        ctx.validate_window = Some(self.0.window.clone());
         let models: Vec<FitOutcome> = if ctx.fits.is_empty() {
             ctx.given.clone().into_iter().collect()
         } else {
