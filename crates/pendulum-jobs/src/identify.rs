@@ -218,8 +218,8 @@ pub fn segment_residuals_of(
         };
         // The window the run was fitted or validated with.
         let window = match rf.role {
-            Role::Identify => ctx.fit_window.clone(),
-            _ => ctx.validate_window.clone(),
+            Role::Identify => ctx.fit_window,
+            _ => ctx.validate_window,
         }
         .unwrap_or_default();
         let (Some(ic), Some(steady)) = (ctx.initial.get(&rf.id), ctx.steady.get(&rf.id)) else {

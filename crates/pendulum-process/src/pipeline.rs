@@ -278,7 +278,7 @@ impl Stage for FitStage {
     }
     fn run(&self, ctx: &mut Context) -> Result<(), ProcessError> {
         let runs = ctx.prepared(Role::Identify, &self.0.window, self.name())?;
-        ctx.fit_window = Some(self.0.window.clone());
+        ctx.fit_window = Some(self.0.window);
         let out = identify(&runs, &self.0, ctx.progress.clone())?;
         ctx.notes
             .extend(crate::identify::shared_omega0_notes(&runs, &out));
@@ -297,7 +297,7 @@ impl Stage for ValidateStage {
     }
     fn run(&self, ctx: &mut Context) -> Result<(), ProcessError> {
         let runs = ctx.prepared(Role::Validate, &self.0.window, self.name())?;
-        ctx.validate_window = Some(self.0.window.clone());
+        ctx.validate_window = Some(self.0.window);
         let models: Vec<FitOutcome> = if ctx.fits.is_empty() {
             ctx.given.clone().into_iter().collect()
         } else {
