@@ -192,6 +192,9 @@ pub fn residuals_of(
     Ok(out)
 }
 
+/// One run's fit residual: run id, role, the series, and each sample's segment number.
+pub type SegmentResiduals = (String, Role, ResidualSeries, Vec<usize>);
+
 /// The residual each fitted model's fit minimised on every run it saw (identify runs from the
 /// fit, validate runs from the validation): multiple-shooting segments restarted from the
 /// measured state over the fit window, with each sample's segment number.
@@ -199,7 +202,7 @@ pub fn segment_residuals_of(
     ctx: &Context,
     fit: &FitOutcome,
     validation: Option<&[RunFit]>,
-) -> Result<Vec<(String, Role, ResidualSeries, Vec<usize>)>, JobError> {
+) -> Result<Vec<SegmentResiduals>, JobError> {
     let mut out = Vec::new();
     let mut all: Vec<&RunFit> = fit.runs.iter().collect();
     if let Some(v) = validation {

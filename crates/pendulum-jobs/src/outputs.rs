@@ -660,12 +660,12 @@ pub fn write_outputs_checked(
         }
         // The residual the fit minimised (mode `segments`), then the free run (mode `free_run`).
         for (id, role, s, segments) in segment_residuals_of(ctx, m, val)? {
-            for k in 0..s.t.len() {
+            for (k, segment) in segments.iter().enumerate() {
                 rs_run.push(id.clone());
                 rs_model.push(m.spec.name.clone());
                 rs_role.push(role.as_str().to_string());
                 rs_mode.push("segments".to_string());
-                rs_segment.push(segments[k] as i64);
+                rs_segment.push(*segment as i64);
                 let v = [
                     s.t[k],
                     s.tau_s[k],
