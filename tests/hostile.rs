@@ -10,7 +10,7 @@ use std::process::Output;
 use pendulum_log::{EncoderMsg, RunLogOptions, METADATA_RUN};
 use pendulum_rig::{
     Campaign, Header, IngestStats, Location, ReadOptions, Sample, SdReader, SdWriter, SerialReader,
-    SerialWriter,
+    SerialWriter, TimelinePlan,
 };
 
 use crate::ingest::{tiny_capture, GOOD_RIG};
@@ -751,6 +751,169 @@ fn regression_issue_13_a_board_reset_starts_a_new_segment() {
         "{:?}",
         st.warnings
     );
+}
+
+/// Reads a capture as `pendulum ingest` and `identify` do: when the first pass shows a block
+/// off the timeline longer than the reader's read-ahead window, the capture is read again with
+/// that block dropped ([`SdReader::timeline_plan`]).
+fn read_capture_whole(bytes: &[u8], sd: bool) -> (Vec<Sample>, IngestStats) {
+    let mut out = Vec::new();
+    let mut plan: Option<TimelinePlan> = None;
+    for reading in 1..=pendulum_rig::capture::MAX_READINGS {
+        out.clear();
+        let (stats, more) = if sd {
+            let mut r = SdReader::new(bytes, "t.bin", ReadOptions::default()).unwrap();
+            if let Some(p) = &plan {
+                r.set_timeline_plan(p.clone());
+            }
+            while let Some(s) = r.next_sample().unwrap() {
+                out.push(s);
+            }
+            (r.stats().clone(), r.timeline_plan())
+        } else {
+            let mut r = SerialReader::new(bytes, "t.csv", ReadOptions::default()).unwrap();
+            if let Some(p) = &plan {
+                r.set_timeline_plan(p.clone());
+            }
+            while let Some(s) = r.next_sample().unwrap() {
+                out.push(s);
+            }
+            (r.stats().clone(), r.timeline_plan())
+        };
+        match more {
+            Some(more) if reading < pendulum_rig::capture::MAX_READINGS => match &mut plan {
+                Some(p) => p.merge(more),
+                None => plan = Some(more),
+            },
+            _ => return (out, stats),
+        }
+    }
+    unreachable!("the last reading returns")
+}
+
+/// Where two lists of kept records first differ (for short failure messages).
+fn first_diff(
+    a: &[(u32, i16)],
+    b: &[(u32, i16)],
+) -> Option<(usize, Option<(u32, i16)>, Option<(u32, i16)>)> {
+    (0..a.len().max(b.len()))
+        .find(|&i| a.get(i) != b.get(i))
+        .map(|i| (i, a.get(i).copied(), b.get(i).copied()))
+}
+
+/// Issue 13, item 2 (the remainder): a stale block LONGER than the read-ahead window (512
+/// records) was still believed: 1,000 rows stamped 10 minutes ahead among 12,000 were kept
+/// behind a 10-minute gap and the rest of the run became a "new segment" re-anchored after
+/// them. The timeline on either side of such a block continues across it and outnumbers it,
+/// so the block is dropped and counted, whatever its length; every good record is kept, with
+/// no gap and no new segment. The same for a block stamped in the past, a block that replaced
+/// good rows (then one gap, as long as what it replaced), and a repeated later chunk of 1,000
+/// serial lines inserted early (recognised as copies when their originals come).
+#[test]
+fn regression_issue_13_a_long_stale_block_is_still_a_minority() {
+    let good = swing(12_000, 1_000_000_000);
+    let want: Vec<(u32, i16)> = good.iter().map(|r| (r.0, r.1)).collect();
+    let shifted = |rows: &[Row], by: i64| -> Vec<Row> {
+        rows.iter()
+            .map(|&(t, e, a)| (t.wrapping_add(by as u32), e, a))
+            .collect()
+    };
+    for sd in [false, true] {
+        let what = if sd { "sd" } else { "serial" };
+        let per_row = if sd { 2 } else { 1 };
+        let encode = |rows: &[Row]| {
+            if sd {
+                sd_bytes(rows, &sd_header_200())
+            } else {
+                serial_bytes(rows, &Header::serial_v1())
+            }
+        };
+        // Inserted: 1,000 stale rows 10 minutes ahead, then 1,000 stamped 10 minutes back.
+        for by in [600_000_000i64, -600_000_000] {
+            let mut rows = good[..6000].to_vec();
+            rows.extend(shifted(&good[6000..7000], by));
+            rows.extend_from_slice(&good[6000..]);
+            let (samples, st) = read_capture_whole(&encode(&rows), sd);
+            let case = format!("{what}, 1,000 rows shifted by {by} µs");
+            let got = encoder_rows(&samples);
+            assert!(
+                got == want,
+                "{case}: every good record kept; {} kept, first difference {:?}",
+                got.len(),
+                first_diff(&got, &want)
+            );
+            assert_eq!(st.accel_samples, 12_000, "{case}");
+            assert_eq!(st.off_timeline, 1000 * per_row, "{case}: {:?}", st.skips);
+            assert_eq!(st.skipped_lines_or_frames, 1000 * per_row, "{case}");
+            assert_eq!(st.gap_count, 0, "{case}: no 10-minute gap: {:?}", st.gaps);
+            assert_eq!(st.new_segments, 0, "{case}: {:?}", st.warnings);
+            assert!(
+                st.skips[0].reason.contains("off the timeline")
+                    && st.skips[0].reason.contains("resumes at"),
+                "{case}: {:?}",
+                st.skips[0]
+            );
+            assert_time_increases(&samples, &case);
+        }
+        // Replaced: the block overwrote 1,000 good rows; the rest is kept after one gap of
+        // their length, on the original time base.
+        let mut rows = good[..6000].to_vec();
+        rows.extend(shifted(&good[6000..7000], 600_000_000));
+        rows.extend_from_slice(&good[7000..]);
+        let (samples, st) = read_capture_whole(&encode(&rows), sd);
+        let mut kept = want[..6000].to_vec();
+        kept.extend_from_slice(&want[7000..]);
+        let got = encoder_rows(&samples);
+        assert!(
+            got == kept,
+            "{what}, replaced: good rows kept; first difference {:?}",
+            first_diff(&got, &kept)
+        );
+        assert_eq!(st.off_timeline, 1000 * per_row, "{what}, replaced");
+        assert_eq!(st.new_segments, 0, "{what}, replaced: {:?}", st.warnings);
+        let t: Vec<u64> = samples
+            .iter()
+            .filter_map(|s| match s {
+                Sample::Encoder(e) => Some(e.t_us),
+                _ => None,
+            })
+            .collect();
+        assert_eq!(
+            t[6000] - t[5999],
+            1001 * 5000,
+            "{what}, replaced: the hole is 5.005 s"
+        );
+        assert_time_increases(&samples, what);
+    }
+
+    // A later chunk of 1,000 serial lines repeated early (a terminal program's buffer).
+    let mut rows = good[..2000].to_vec();
+    rows.extend_from_slice(&good[9000..10_000]);
+    rows.extend_from_slice(&good[2000..]);
+    let (samples, st) = read_capture_whole(&serial_bytes(&rows, &Header::serial_v1()), false);
+    let got = encoder_rows(&samples);
+    assert!(
+        got == want,
+        "the copy dropped, every original kept; first difference {:?}",
+        first_diff(&got, &want)
+    );
+    assert_eq!(
+        (st.off_timeline, st.duplicates),
+        (1000, 1000),
+        "{:?}",
+        st.skips
+    );
+    assert_eq!((st.gap_count, st.new_segments), (0, 0), "{:?}", st.warnings);
+
+    // A majority is never dropped: 7,000 rows after a board reset between 2,500 before and
+    // 2,500 that would continue the first part stay (the reset is a new segment).
+    let mut rows = good[..2500].to_vec();
+    rows.extend(swing(7000, 300_000));
+    rows.extend_from_slice(&good[2500..5000]);
+    let (samples, st) = read_capture_whole(&serial_bytes(&rows, &Header::serial_v1()), false);
+    assert_eq!(samples.len(), 2 * 12_000, "nothing dropped: {:?}", st.skips);
+    assert_eq!(st.off_timeline, 0);
+    assert_eq!(st.new_segments, 1, "{:?}", st.warnings);
 }
 
 /// Script 03: a garbled digit that stays a digit (an 8,000-count encoder jump in 5 ms) was kept

@@ -25,11 +25,26 @@ pub fn read_capture(spec: &RunSpec, g_m_s2: f64) -> Result<ReadCapture, JobError
         g_m_s2,
         ..ReadOptions::default()
     };
-    let mut reader = CaptureReader::open_run(spec, opts)?;
-    let mut samples = Vec::new();
-    while let Some(s) = reader.next_sample()? {
-        samples.push(s);
-    }
+    // Read again while a reading finds blocks off the timeline longer than the reader's
+    // read-ahead (as `pendulum ingest` does).
+    let mut plan: Option<pendulum_rig::TimelinePlan> = None;
+    let mut reading = 0;
+    let (reader, samples) = loop {
+        reading += 1;
+        let mut reader = CaptureReader::open_run_planned(spec, opts, plan.as_ref())?;
+        let mut samples = Vec::new();
+        while let Some(s) = reader.next_sample()? {
+            samples.push(s);
+        }
+        let more = match reader.timeline_plan() {
+            Some(more) if reading < pendulum_rig::capture::MAX_READINGS => more,
+            _ => break (reader, samples),
+        };
+        match &mut plan {
+            Some(p) => p.merge(more),
+            None => plan = Some(more),
+        }
+    };
     // The rule `pendulum ingest` applies: a run that kept almost nothing is no run to fit.
     if let Some(why) = reader.stats().failure() {
         return Err(JobError::Invalid(format!(

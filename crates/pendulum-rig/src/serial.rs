@@ -10,8 +10,8 @@ use std::path::{Path, PathBuf};
 use crate::capture::{
     accel_si, accel_step_plausible, check_rate, encoder_step_plausible, signed_step, snippet,
     theta_rad, value_glitch, AccelSample, Clock, Counter, EncoderSample, GapTracker, Header,
-    IngestStats, Location, Lookahead, OrderRule, ReadOptions, Recent, Record, Sample, Timeline,
-    CONFIRM_RECORDS, RATE_PROBE_RECORDS, TIMELINE_WINDOW,
+    IngestStats, Location, Lookahead, OrderRule, ReadOptions, Recent, Record, Sample, SegmentLog,
+    Timeline, TimelinePlan, CONFIRM_RECORDS, RATE_PROBE_RECORDS, TIMELINE_WINDOW,
 };
 use crate::error::RigError;
 
@@ -62,6 +62,10 @@ pub struct SerialReader<R: BufRead> {
     probed: bool,
     period_us: f64,
     recent: Recent,
+    /// Where the clock jumped between kept lines, for [`SerialReader::timeline_plan`].
+    segments: SegmentLog,
+    /// Blocks an earlier reading found off the timeline: dropped as they are read.
+    plan: TimelinePlan,
     /// The last kept line's raw time and values, for the plausibility of the next.
     last_row: Option<(u32, i16, [i16; 3])>,
     pending_accel: Option<AccelSample>,
@@ -93,6 +97,8 @@ impl<R: BufRead> SerialReader<R> {
             probed: false,
             period_us: 5000.0,
             recent: Recent::default(),
+            segments: SegmentLog::default(),
+            plan: TimelinePlan::default(),
             last_row: None,
             pending_accel: None,
             clock: Clock::default(),
@@ -194,6 +200,22 @@ impl<R: BufRead> SerialReader<R> {
 
     pub fn stats(&self) -> &IngestStats {
         &self.stats
+    }
+
+    /// Drops the blocks of `plan` (from an earlier reading of the same capture) as they are
+    /// read, each with a warning. Call before the first [`SerialReader::next_sample`].
+    pub fn set_timeline_plan(&mut self, plan: TimelinePlan) {
+        for w in plan.warnings() {
+            self.stats.warn(w);
+        }
+        self.plan = plan;
+    }
+
+    /// After the last sample: the blocks this reading kept that the majority of the evidence
+    /// puts off the timeline (see [`TimelinePlan`]), or `None` when there are none. Read the
+    /// capture again with [`SerialReader::set_timeline_plan`] to drop them.
+    pub fn timeline_plan(&self) -> Option<TimelinePlan> {
+        self.segments.plan(self.order)
     }
 
     fn not_a_capture(&self, line: u64, reason: String) -> RigError {
@@ -304,13 +326,22 @@ impl<R: BufRead> SerialReader<R> {
             }
             match parse_row(&self.line) {
                 Ok((t_us, enc, accel)) => {
-                    return Ok(Some(Row {
+                    let row = Row {
                         line: info.number,
                         bytes: info.bytes,
                         t_us,
                         enc,
                         accel,
-                    }))
+                    };
+                    let at = Location::Line(info.number);
+                    if let Some(b) = self.plan.covering(at) {
+                        let reason = format!("{}: dropped", TimelinePlan::reason(b, t_us));
+                        self.stats.off_timeline += 1;
+                        self.recent.push_dropped(&row);
+                        self.stats.skip(at, reason, info.bytes);
+                        continue;
+                    }
+                    return Ok(Some(row));
                 }
                 Err(why) => {
                     let reason = format!("{why}: {}", snippet(&self.line));
@@ -387,6 +418,12 @@ impl<R: BufRead> SerialReader<R> {
                 self.stats.skip(at, format!("{why}: dropped"), cand.bytes);
                 continue;
             }
+            let jumped = segment.is_some()
+                || self.clock.last_raw().is_some_and(|p| {
+                    let s = signed_step(p, cand.t_us);
+                    s < self.order.min_step_us || s > self.order.max_lone_step_us
+                });
+            self.segments.kept(at, cand.t_us, jumped);
             match segment {
                 Some(reset) => {
                     self.clock.reanchor(cand.t_us, t_us);
