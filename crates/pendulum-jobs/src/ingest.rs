@@ -382,6 +382,12 @@ pub fn run(dir: &Path, out_dir: &Path, show_progress: bool) -> Result<IngestSumm
         })
         .collect();
     bar.finish_and_clear();
+    // Every run in: the folder is complete (the marker is written last; `prepare_out_dir`
+    // removed any earlier one). A failed run leaves it without one.
+    if rows.iter().all(|r| r.error.is_none()) {
+        let files: Vec<PathBuf> = rows.iter().filter_map(|r| r.mcap.clone()).collect();
+        crate::outputs::mark_complete(out_dir, "pendulum ingest", &files)?;
+    }
     Ok(IngestSummary {
         campaign: c.name.clone(),
         rows,
