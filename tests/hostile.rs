@@ -886,6 +886,42 @@ fn regression_issue_13_a_long_stale_block_is_still_a_minority() {
         assert_time_increases(&samples, what);
     }
 
+    // Real gaps (bursts of lost records, short and long) are no block: every record is kept
+    // (a first version of the fix took the records between two gaps for one).
+    for sd in [false, true] {
+        let rows: Vec<Row> = good
+            .iter()
+            .enumerate()
+            .filter(|(k, _)| {
+                !((1000..1010).contains(k)
+                    || (3000..3600).contains(k)
+                    || (5000..5040).contains(k)
+                    || (8000..8700).contains(k))
+            })
+            .map(|(_, r)| *r)
+            .collect();
+        let bytes = if sd {
+            sd_bytes(&rows, &sd_header_200())
+        } else {
+            serial_bytes(&rows, &Header::serial_v1())
+        };
+        let (samples, st) = read_capture_whole(&bytes, sd);
+        let want_gaps: Vec<(u32, i16)> = rows.iter().map(|r| (r.0, r.1)).collect();
+        let got = encoder_rows(&samples);
+        assert!(
+            got == want_gaps,
+            "sd={sd}: real gaps keep every record; first difference {:?}",
+            first_diff(&got, &want_gaps)
+        );
+        assert_eq!((st.off_timeline, st.new_segments), (0, 0), "sd={sd}");
+        assert_eq!(
+            st.gap_count,
+            if sd { 8 } else { 4 },
+            "sd={sd}: {:?}",
+            st.gaps
+        );
+    }
+
     // A later chunk of 1,000 serial lines repeated early (a terminal program's buffer).
     let mut rows = good[..2000].to_vec();
     rows.extend_from_slice(&good[9000..10_000]);
@@ -1713,4 +1749,78 @@ fn regression_issue_13_mcaps_of_two_campaigns_are_not_fitted_together_unless_ask
     let o = identify(&["--mix-campaigns"]);
     assert!(o.status.success(), "{:?}", text(&o));
     assert!(root.path().join("out/params.parquet").exists());
+}
+
+/// Issue 13 item 9 (the rest): a capture with 19 MB of header lines was read into memory
+/// (94 MB for ingest), a `campaign.toml` with a 19 MB name took 170 MB. The serial header is
+/// bounded (64 KiB, a firmware header is ~150 bytes), so is a header line (1 KiB) and
+/// `campaign.toml` (1 MiB, lines of 64 KiB): each refused before it is held, naming the file,
+/// the line and the byte offset.
+#[test]
+fn regression_issue_13_huge_headers_are_refused_up_front() {
+    let rows = swing(100, 1_000_000);
+    let good = serial_bytes(&rows, &Header::serial_v1());
+    let mut huge = Vec::new();
+    for i in 0..19_000 {
+        huge.extend_from_slice(format!("# k{i}={}\n", "x".repeat(1000)).as_bytes());
+    }
+    huge.extend_from_slice(&good);
+    let e = SerialReader::new(&huge[..], "huge.csv", ReadOptions::default())
+        .err()
+        .expect("refused")
+        .to_string();
+    assert!(
+        e.contains("huge.csv") && e.contains("65536") && e.contains("line 66, byte 66"),
+        "{e}"
+    );
+    // One line too long: its number and where it starts.
+    let text = String::from_utf8(good.clone()).unwrap();
+    let long = text.replacen(
+        "# encoder_cpr=4096",
+        &format!("# note={}", "y".repeat(5000)),
+        1,
+    );
+    let e = SerialReader::new(long.as_bytes(), "long.csv", ReadOptions::default())
+        .err()
+        .expect("refused")
+        .to_string();
+    assert!(
+        e.contains("long.csv") && e.contains("header line 2 (from byte 21)"),
+        "{e}"
+    );
+    // A long header within the bound still reads.
+    let notes = text.replacen(
+        "# encoder_cpr=4096",
+        &format!("# note={}\n# encoder_cpr=4096", "z".repeat(900)),
+        1,
+    );
+    let (samples, _) = read_capture(notes.as_bytes(), false);
+    assert_eq!(samples.len(), 200);
+
+    let root = tempfile::tempdir().unwrap();
+    let camp = campaign(
+        root.path(),
+        "[[run]]\nid = \"r01\"\nfile = \"r01.csv\"\nrole = \"identify\"\n",
+    );
+    let toml = camp.join("campaign.toml");
+    let base = std::fs::read_to_string(&toml).unwrap();
+    std::fs::write(&toml, format!("{base}# {}\n", "n".repeat(2 << 20))).unwrap();
+    let e = Campaign::load(&camp).err().expect("refused").to_string();
+    assert!(
+        e.contains("campaign.toml") && e.contains("more than 1048576 bytes"),
+        "{e}"
+    );
+    let lines = base.lines().count();
+    std::fs::write(&toml, format!("{base}# {}\n", "n".repeat(100_000))).unwrap();
+    let e = Campaign::load(&camp).err().expect("refused").to_string();
+    assert!(
+        e.contains(&format!("line {}, byte {}", lines + 1, base.len()))
+            && e.contains("100002 bytes"),
+        "{e}"
+    );
+    std::fs::write(&toml, format!("{base}# {}\n", "n".repeat(1000))).unwrap();
+    assert!(
+        Campaign::load(&camp).is_ok(),
+        "a long comment within the bound loads"
+    );
 }

@@ -978,8 +978,9 @@ impl SegmentLog {
     ///
     /// A block (one or a few consecutive segments) is off the timeline when the segment after
     /// it continues the segment before it (the step between them is in order and no longer
-    /// than the block could have covered: the block was inserted, or replaced as many records)
-    /// and the two together hold more records than the block. The clock cannot leave its
+    /// than the block could have covered: the block was inserted, or replaced as many records),
+    /// the block's stamps do not lie between the two (records after real gaps do), and the two
+    /// together hold more records than the block. The clock cannot leave its
     /// timeline and come back to it, so the side that does not fit is the damage: a stale or
     /// future-stamped block, or a chunk repeated out of place, whatever its length. A first or
     /// last segment has only one side: nothing says which of the two is right, so both stay
@@ -1007,7 +1008,13 @@ impl SegmentLog {
                             .saturating_mul(i64::try_from(inside).unwrap_or(i64::MAX)),
                     );
                     let around = before.records + after.records;
-                    if step >= rule.min_step_us && step <= reach && inside < around {
+                    // Every segment of the block lies off the line from `before` to `after`
+                    // (real data after real gaps lies between them in time).
+                    let off = segs[i..j].iter().all(|s| {
+                        signed_step(before.last_raw, s.first_raw) < rule.min_step_us
+                            || signed_step(s.last_raw, after.first_raw) < rule.min_step_us
+                    });
+                    if off && step >= rule.min_step_us && step <= reach && inside < around {
                         let ratio = inside as f64 / around as f64;
                         if best.is_none_or(|b| ratio < b.0) {
                             best = Some((ratio, i, j));
