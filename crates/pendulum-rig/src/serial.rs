@@ -21,6 +21,11 @@ pub const COLUMN_LINE: &str = "t_us,enc,ax,ay,az";
 /// Longer lines are garbage: a real sample line is at most ~40 bytes.
 const MAX_LINE_BYTES: usize = 1024;
 
+/// A header (the `#` lines before the column line) longer than this is refused: the firmware's
+/// is about 150 bytes; 64 KiB leaves room for any notes and keeps a damaged or hostile file
+/// (19 MB of `#` lines used to be read into memory, 94 MB) from growing memory.
+pub const MAX_HEADER_BYTES: u64 = 64 * 1024;
+
 /// A syntactically valid data line, not yet accepted.
 struct Row {
     line: u64,
@@ -56,6 +61,8 @@ pub struct SerialReader<R: BufRead> {
     lsb_per_g: f64,
     order: OrderRule,
     line_no: u64,
+    /// Bytes read so far (where the next line starts).
+    byte_pos: u64,
     line: Vec<u8>,
     lookahead: Lookahead<Row>,
     /// The rate was checked against the first records ([`SerialReader::probe_rate`]).
@@ -92,6 +99,7 @@ impl<R: BufRead> SerialReader<R> {
                 max_lone_step_us: 15_000,
             },
             line_no: 0,
+            byte_pos: 0,
             line: Vec::with_capacity(128),
             lookahead: Lookahead::default(),
             probed: false,
@@ -229,6 +237,16 @@ impl<R: BufRead> SerialReader<R> {
     fn read_header(&mut self) -> Result<(), RigError> {
         let mut seen_header = false;
         loop {
+            if self.byte_pos > MAX_HEADER_BYTES {
+                return Err(self.not_a_capture(
+                    self.line_no,
+                    format!(
+                        "the header runs past {MAX_HEADER_BYTES} bytes (line {}, byte {}) without \
+                         the column line `{COLUMN_LINE}`: a capture's header is a few hundred bytes",
+                        self.line_no, self.byte_pos
+                    ),
+                ));
+            }
             let Some(info) = self.read_line()? else {
                 let reason = if seen_header {
                     format!("the file ends before the column line `{COLUMN_LINE}`")
@@ -240,7 +258,10 @@ impl<R: BufRead> SerialReader<R> {
             if info.overlong {
                 return Err(self.not_a_capture(
                     info.number,
-                    format!("header line longer than {MAX_LINE_BYTES} bytes"),
+                    format!(
+                        "header line {} (from byte {}) is {} bytes, longer than {MAX_LINE_BYTES}",
+                        info.number, info.start, info.bytes
+                    ),
                 ));
             }
             let mut content: &[u8] = &self.line;
@@ -290,6 +311,7 @@ impl<R: BufRead> SerialReader<R> {
             &mut self.reader,
             &mut self.line,
             &mut self.line_no,
+            &mut self.byte_pos,
             MAX_LINE_BYTES,
         )
         .map_err(|e| RigError::io(&self.path, e))
@@ -304,7 +326,10 @@ impl<R: BufRead> SerialReader<R> {
             if info.overlong {
                 self.stats.skip(
                     Location::Line(info.number),
-                    format!("line longer than {MAX_LINE_BYTES} bytes (garbage)"),
+                    format!(
+                        "line of {} bytes from byte {}, longer than {MAX_LINE_BYTES} (garbage)",
+                        info.bytes, info.start
+                    ),
                     info.bytes,
                 );
                 continue;
