@@ -791,11 +791,11 @@ fn read_capture_whole(bytes: &[u8], sd: bool) -> (Vec<Sample>, IngestStats) {
     unreachable!("the last reading returns")
 }
 
+/// Where two lists differ first, and their records there.
+type Diff = (usize, Option<(u32, i16)>, Option<(u32, i16)>);
+
 /// Where two lists of kept records first differ (for short failure messages).
-fn first_diff(
-    a: &[(u32, i16)],
-    b: &[(u32, i16)],
-) -> Option<(usize, Option<(u32, i16)>, Option<(u32, i16)>)> {
+fn first_diff(a: &[(u32, i16)], b: &[(u32, i16)]) -> Option<Diff> {
     (0..a.len().max(b.len()))
         .find(|&i| a.get(i) != b.get(i))
         .map(|i| (i, a.get(i).copied(), b.get(i).copied()))
@@ -1805,14 +1805,14 @@ fn regression_issue_13_huge_headers_are_refused_up_front() {
     let toml = camp.join("campaign.toml");
     let base = std::fs::read_to_string(&toml).unwrap();
     std::fs::write(&toml, format!("{base}# {}\n", "n".repeat(2 << 20))).unwrap();
-    let e = Campaign::load(&camp).err().expect("refused").to_string();
+    let e = Campaign::load(&camp).expect_err("refused").to_string();
     assert!(
         e.contains("campaign.toml") && e.contains("more than 1048576 bytes"),
         "{e}"
     );
     let lines = base.lines().count();
     std::fs::write(&toml, format!("{base}# {}\n", "n".repeat(100_000))).unwrap();
-    let e = Campaign::load(&camp).err().expect("refused").to_string();
+    let e = Campaign::load(&camp).expect_err("refused").to_string();
     assert!(
         e.contains(&format!("line {}, byte {}", lines + 1, base.len()))
             && e.contains("100002 bytes"),

@@ -188,7 +188,7 @@ fn ingest_run(c: &Campaign, spec: &RunSpec, out_dir: &Path) -> Result<IngestRow,
     for reading in 1..=pendulum_rig::capture::MAX_READINGS {
         let last = reading == pendulum_rig::capture::MAX_READINGS;
         match ingest_reading(c, spec, out_dir, plan.as_ref(), last)? {
-            Reading::Done(row) => return Ok(row),
+            Reading::Done(row) => return Ok(*row),
             Reading::Again(more) => match &mut plan {
                 Some(p) => p.merge(more),
                 None => plan = Some(more),
@@ -200,7 +200,7 @@ fn ingest_run(c: &Campaign, spec: &RunSpec, out_dir: &Path) -> Result<IngestRow,
 
 /// One reading of a capture into its MCAP.
 enum Reading {
-    Done(IngestRow),
+    Done(Box<IngestRow>),
     /// The reading kept blocks off the timeline: its MCAP was discarded (never under the final
     /// name), to be read again dropping them.
     Again(TimelinePlan),
@@ -290,25 +290,25 @@ fn ingest_reading(
         // Dropped unfinished: the writer removes its temporary file, so no near-empty MCAP
         // takes the final name; the row keeps the stats so that the skips are listed.
         drop(w);
-        return Ok(Reading::Done(IngestRow {
+        return Ok(Reading::Done(Box::new(IngestRow {
             run_id: spec.id.clone(),
             format: reader.format().to_string(),
             mcap: None,
             stats: Some(stats),
             error: Some(format!("{}: failed run: {why}", spec.file.display())),
             warnings,
-        }));
+        })));
     }
     w.write_stats(&stats_json(&stats, reader.format()))?;
     let summary = w.finish()?;
-    Ok(Reading::Done(IngestRow {
+    Ok(Reading::Done(Box::new(IngestRow {
         run_id: spec.id.clone(),
         format: reader.format().to_string(),
         mcap: Some(summary.path),
         stats: Some(stats),
         error: None,
         warnings,
-    }))
+    })))
 }
 
 /// Where a run's MCAP goes (the id is a safe file name: [`pendulum_rig::names`]).

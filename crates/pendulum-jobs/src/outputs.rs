@@ -166,7 +166,7 @@ pub fn remove_stale_temps_of(dir: &Path, names: &[String]) -> Result<Vec<PathBuf
         return Ok(Vec::new());
     }
     remove_stale_temps_where(dir, |name| {
-        target(name).is_some_and(|base| names.iter().any(|n| *n == base))
+        target(name).is_some_and(|base| names.contains(&base))
     })
 }
 
