@@ -309,7 +309,8 @@ fn check_one_campaign(
         .collect();
     Err(JobError::Invalid(format!(
         "{}: the MCAP files hold runs of {} campaigns: {}: refusing to fit them together (one \
-         set of parameters for different rigs or days); pass --mix-campaigns to do it on purpose",
+         set of parameters for different rigs or days); `identify` and `validate` take \
+         --mix-campaigns to do it on purpose",
         dir.display(),
         by.len(),
         list.join(" and ")
