@@ -181,3 +181,45 @@ fn pipeline_files_parse_and_build() {
         .to_string();
     assert!(e.contains("bad.toml:") && e.contains("fit_windw_s"), "{e}");
 }
+
+/// Issue 13: `pendulum … | head` used to panic when `head` had what it wanted and closed the
+/// pipe ("failed printing to stdout: Broken pipe", exit 101). A reader that goes away is not
+/// the job's failure: the rest of the report is dropped quietly and the exit code is the job's
+/// own (0 here; a failed job still exits 1, its error on stderr). The pipe is closed before
+/// the binary writes anything (it prints after its work).
+#[test]
+fn issue_13_a_closed_stdout_is_no_panic() {
+    use std::process::Stdio;
+    for args in [
+        &["demo", "--quick", "--grid", "2"][..],
+        &["simulate", "--t-end", "100"][..],
+    ] {
+        let mut child = pendulum()
+            .args(args)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        drop(child.stdout.take());
+        let out = child.wait_with_output().unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(0), "{args:?}: {stderr}");
+        assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+        assert!(stderr.is_empty(), "{args:?}: quiet, got {stderr}");
+    }
+    // A failing job keeps its failure.
+    let mut child = pendulum()
+        .args(["simulate", "--param", "nonsense=1"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("error:") && stderr.contains("nonsense"),
+        "{stderr}"
+    );
+}

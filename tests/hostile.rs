@@ -10,7 +10,7 @@ use std::process::Output;
 use pendulum_log::{EncoderMsg, RunLogOptions, METADATA_RUN};
 use pendulum_rig::{
     Campaign, Header, IngestStats, Location, ReadOptions, Sample, SdReader, SdWriter, SerialReader,
-    SerialWriter,
+    SerialWriter, TimelinePlan,
 };
 
 use crate::ingest::{tiny_capture, GOOD_RIG};
@@ -753,6 +753,205 @@ fn regression_issue_13_a_board_reset_starts_a_new_segment() {
     );
 }
 
+/// Reads a capture as `pendulum ingest` and `identify` do: when the first pass shows a block
+/// off the timeline longer than the reader's read-ahead window, the capture is read again with
+/// that block dropped ([`SdReader::timeline_plan`]).
+fn read_capture_whole(bytes: &[u8], sd: bool) -> (Vec<Sample>, IngestStats) {
+    let mut out = Vec::new();
+    let mut plan: Option<TimelinePlan> = None;
+    for reading in 1..=pendulum_rig::capture::MAX_READINGS {
+        out.clear();
+        let (stats, more) = if sd {
+            let mut r = SdReader::new(bytes, "t.bin", ReadOptions::default()).unwrap();
+            if let Some(p) = &plan {
+                r.set_timeline_plan(p.clone());
+            }
+            while let Some(s) = r.next_sample().unwrap() {
+                out.push(s);
+            }
+            (r.stats().clone(), r.timeline_plan())
+        } else {
+            let mut r = SerialReader::new(bytes, "t.csv", ReadOptions::default()).unwrap();
+            if let Some(p) = &plan {
+                r.set_timeline_plan(p.clone());
+            }
+            while let Some(s) = r.next_sample().unwrap() {
+                out.push(s);
+            }
+            (r.stats().clone(), r.timeline_plan())
+        };
+        match more {
+            Some(more) if reading < pendulum_rig::capture::MAX_READINGS => match &mut plan {
+                Some(p) => p.merge(more),
+                None => plan = Some(more),
+            },
+            _ => return (out, stats),
+        }
+    }
+    unreachable!("the last reading returns")
+}
+
+/// Where two lists differ first, and their records there.
+type Diff = (usize, Option<(u32, i16)>, Option<(u32, i16)>);
+
+/// Where two lists of kept records first differ (for short failure messages).
+fn first_diff(a: &[(u32, i16)], b: &[(u32, i16)]) -> Option<Diff> {
+    (0..a.len().max(b.len()))
+        .find(|&i| a.get(i) != b.get(i))
+        .map(|i| (i, a.get(i).copied(), b.get(i).copied()))
+}
+
+/// Issue 13, item 2 (the remainder): a stale block LONGER than the read-ahead window (512
+/// records) was still believed: 1,000 rows stamped 10 minutes ahead among 12,000 were kept
+/// behind a 10-minute gap and the rest of the run became a "new segment" re-anchored after
+/// them. The timeline on either side of such a block continues across it and outnumbers it,
+/// so the block is dropped and counted, whatever its length; every good record is kept, with
+/// no gap and no new segment. The same for a block stamped in the past, a block that replaced
+/// good rows (then one gap, as long as what it replaced), and a repeated later chunk of 1,000
+/// serial lines inserted early (recognised as copies when their originals come).
+#[test]
+fn regression_issue_13_a_long_stale_block_is_still_a_minority() {
+    let good = swing(12_000, 1_000_000_000);
+    let want: Vec<(u32, i16)> = good.iter().map(|r| (r.0, r.1)).collect();
+    let shifted = |rows: &[Row], by: i64| -> Vec<Row> {
+        rows.iter()
+            .map(|&(t, e, a)| (t.wrapping_add(by as u32), e, a))
+            .collect()
+    };
+    for sd in [false, true] {
+        let what = if sd { "sd" } else { "serial" };
+        let per_row = if sd { 2 } else { 1 };
+        let encode = |rows: &[Row]| {
+            if sd {
+                sd_bytes(rows, &sd_header_200())
+            } else {
+                serial_bytes(rows, &Header::serial_v1())
+            }
+        };
+        // Inserted: 1,000 stale rows 10 minutes ahead, then 1,000 stamped 10 minutes back.
+        for by in [600_000_000i64, -600_000_000] {
+            let mut rows = good[..6000].to_vec();
+            rows.extend(shifted(&good[6000..7000], by));
+            rows.extend_from_slice(&good[6000..]);
+            let (samples, st) = read_capture_whole(&encode(&rows), sd);
+            let case = format!("{what}, 1,000 rows shifted by {by} µs");
+            let got = encoder_rows(&samples);
+            assert!(
+                got == want,
+                "{case}: every good record kept; {} kept, first difference {:?}",
+                got.len(),
+                first_diff(&got, &want)
+            );
+            assert_eq!(st.accel_samples, 12_000, "{case}");
+            assert_eq!(st.off_timeline, 1000 * per_row, "{case}: {:?}", st.skips);
+            assert_eq!(st.skipped_lines_or_frames, 1000 * per_row, "{case}");
+            assert_eq!(st.gap_count, 0, "{case}: no 10-minute gap: {:?}", st.gaps);
+            assert_eq!(st.new_segments, 0, "{case}: {:?}", st.warnings);
+            assert!(
+                st.skips[0].reason.contains("off the timeline")
+                    && st.skips[0].reason.contains("resumes at"),
+                "{case}: {:?}",
+                st.skips[0]
+            );
+            assert_time_increases(&samples, &case);
+        }
+        // Replaced: the block overwrote 1,000 good rows; the rest is kept after one gap of
+        // their length, on the original time base.
+        let mut rows = good[..6000].to_vec();
+        rows.extend(shifted(&good[6000..7000], 600_000_000));
+        rows.extend_from_slice(&good[7000..]);
+        let (samples, st) = read_capture_whole(&encode(&rows), sd);
+        let mut kept = want[..6000].to_vec();
+        kept.extend_from_slice(&want[7000..]);
+        let got = encoder_rows(&samples);
+        assert!(
+            got == kept,
+            "{what}, replaced: good rows kept; first difference {:?}",
+            first_diff(&got, &kept)
+        );
+        assert_eq!(st.off_timeline, 1000 * per_row, "{what}, replaced");
+        assert_eq!(st.new_segments, 0, "{what}, replaced: {:?}", st.warnings);
+        let t: Vec<u64> = samples
+            .iter()
+            .filter_map(|s| match s {
+                Sample::Encoder(e) => Some(e.t_us),
+                _ => None,
+            })
+            .collect();
+        assert_eq!(
+            t[6000] - t[5999],
+            1001 * 5000,
+            "{what}, replaced: the hole is 5.005 s"
+        );
+        assert_time_increases(&samples, what);
+    }
+
+    // Real gaps (bursts of lost records, short and long) are no block: every record is kept
+    // (a first version of the fix took the records between two gaps for one).
+    for sd in [false, true] {
+        let rows: Vec<Row> = good
+            .iter()
+            .enumerate()
+            .filter(|(k, _)| {
+                !((1000..1010).contains(k)
+                    || (3000..3600).contains(k)
+                    || (5000..5040).contains(k)
+                    || (8000..8700).contains(k))
+            })
+            .map(|(_, r)| *r)
+            .collect();
+        let bytes = if sd {
+            sd_bytes(&rows, &sd_header_200())
+        } else {
+            serial_bytes(&rows, &Header::serial_v1())
+        };
+        let (samples, st) = read_capture_whole(&bytes, sd);
+        let want_gaps: Vec<(u32, i16)> = rows.iter().map(|r| (r.0, r.1)).collect();
+        let got = encoder_rows(&samples);
+        assert!(
+            got == want_gaps,
+            "sd={sd}: real gaps keep every record; first difference {:?}",
+            first_diff(&got, &want_gaps)
+        );
+        assert_eq!((st.off_timeline, st.new_segments), (0, 0), "sd={sd}");
+        assert_eq!(
+            st.gap_count,
+            if sd { 8 } else { 4 },
+            "sd={sd}: {:?}",
+            st.gaps
+        );
+    }
+
+    // A later chunk of 1,000 serial lines repeated early (a terminal program's buffer).
+    let mut rows = good[..2000].to_vec();
+    rows.extend_from_slice(&good[9000..10_000]);
+    rows.extend_from_slice(&good[2000..]);
+    let (samples, st) = read_capture_whole(&serial_bytes(&rows, &Header::serial_v1()), false);
+    let got = encoder_rows(&samples);
+    assert!(
+        got == want,
+        "the copy dropped, every original kept; first difference {:?}",
+        first_diff(&got, &want)
+    );
+    assert_eq!(
+        (st.off_timeline, st.duplicates),
+        (1000, 1000),
+        "{:?}",
+        st.skips
+    );
+    assert_eq!((st.gap_count, st.new_segments), (0, 0), "{:?}", st.warnings);
+
+    // A majority is never dropped: 7,000 rows after a board reset between 2,500 before and
+    // 2,500 that would continue the first part stay (the reset is a new segment).
+    let mut rows = good[..2500].to_vec();
+    rows.extend(swing(7000, 300_000));
+    rows.extend_from_slice(&good[2500..5000]);
+    let (samples, st) = read_capture_whole(&serial_bytes(&rows, &Header::serial_v1()), false);
+    assert_eq!(samples.len(), 2 * 12_000, "nothing dropped: {:?}", st.skips);
+    assert_eq!(st.off_timeline, 0);
+    assert_eq!(st.new_segments, 1, "{:?}", st.warnings);
+}
+
 /// Script 03: a garbled digit that stays a digit (an 8,000-count encoder jump in 5 ms) was kept
 /// and multiplied a run's E_θ by 100. Both readers drop values that move faster than the
 /// pendulum (25 rev/s) or the shaker (2,000 m/s³) can, and report them; fast but physical
@@ -1223,4 +1422,405 @@ fn regression_issue_13_out_checked_before_the_fit_and_causes_said_once() {
     let (stdout, stderr) = text(&o);
     assert_eq!(o.status.code(), Some(1), "{stdout}{stderr}");
     assert_eq!(stderr.matches("Not a directory").count(), 1, "{stderr}");
+}
+
+/// The `tEXt` entries of a PNG file (keyword → text), read by hand: chunk by chunk from the
+/// signature, checking each chunk's CRC-32 as a PNG reader does.
+fn png_text(path: &Path) -> BTreeMap<String, String> {
+    fn crc32(bytes: &[u8]) -> u32 {
+        let mut c = !0u32;
+        for &b in bytes {
+            c ^= u32::from(b);
+            for _ in 0..8 {
+                c = if c & 1 != 0 {
+                    (c >> 1) ^ 0xEDB8_8320
+                } else {
+                    c >> 1
+                };
+            }
+        }
+        !c
+    }
+    let png = std::fs::read(path).unwrap();
+    assert!(png.starts_with(b"\x89PNG\r\n\x1a\n"), "{}", path.display());
+    let mut out = BTreeMap::new();
+    let mut i = 8;
+    while i + 12 <= png.len() {
+        let len = u32::from_be_bytes(png[i..i + 4].try_into().unwrap()) as usize;
+        let body = &png[i + 4..i + 8 + len];
+        let crc = u32::from_be_bytes(png[i + 8 + len..i + 12 + len].try_into().unwrap());
+        assert_eq!(crc, crc32(body), "{}: chunk CRC", path.display());
+        if &body[..4] == b"tEXt" {
+            let data = &body[4..];
+            let z = data.iter().position(|&b| b == 0).unwrap();
+            out.insert(
+                String::from_utf8_lossy(&data[..z]).into_owned(),
+                String::from_utf8_lossy(&data[z + 1..]).into_owned(),
+            );
+        }
+        if &body[..4] == b"IEND" {
+            break;
+        }
+        i += 12 + len;
+    }
+    out
+}
+
+/// The completion marker of `dir`: its invocation id and the files it names.
+fn marker(dir: &Path) -> Option<(String, Vec<String>)> {
+    let text = std::fs::read_to_string(dir.join("complete.json")).ok()?;
+    let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let files = v["files"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| f.as_str().unwrap().to_string())
+        .collect();
+    Some((v["invocation_id"].as_str().unwrap().to_string(), files))
+}
+
+/// Seeds `dir/name` as a file last modified an hour ago.
+fn seed_old(dir: &Path, name: &str) {
+    let p = dir.join(name);
+    std::fs::write(&p, "left behind").unwrap();
+    let f = std::fs::File::options().write(true).open(&p).unwrap();
+    f.set_modified(std::time::SystemTime::now() - std::time::Duration::from_secs(3600))
+        .unwrap();
+}
+
+/// Script 07 (the rest of issue 13 item 6): a result folder is one unit. Every PNG carries the
+/// invocation id of the tables beside it (a `tEXt` chunk); `identify`, `ingest` and `synth`
+/// write `complete.json` last, with that id and the files written; a command starting in the
+/// folder removes it first, so a folder it was killed or failed in is recognisably incomplete
+/// (here a failing `identify` over a finished result: before, the result looked complete).
+/// `simulate` and `replay` write one file, whole, carrying the id; each sweeps only its own
+/// stale temporary files from the folder it writes into, nothing else.
+#[test]
+fn regression_issue_13_a_result_folder_is_complete_or_recognisably_incomplete() {
+    let root = tempfile::tempdir().unwrap();
+    let (mc, idr) = identified_campaign(&root.path().join("twin"));
+    let ids = invocation_ids(&idr);
+    let (id, files) = marker(&idr).expect("identify wrote complete.json");
+    assert!(ids.values().all(|v| *v == id), "{id} vs {ids:?}");
+    let pngs: Vec<String> = files
+        .iter()
+        .filter(|f| f.ends_with(".png"))
+        .cloned()
+        .collect();
+    assert!(pngs.len() >= 2, "{files:?}");
+    for p in &pngs {
+        assert_eq!(
+            png_text(&idr.join(p)).get("invocation_id"),
+            Some(&id),
+            "{p}"
+        );
+    }
+    for t in ids.keys() {
+        assert!(files.contains(t), "{t} not in {files:?}");
+    }
+    for f in &files {
+        assert!(idr.join(f).is_file(), "{f} listed but missing");
+    }
+    let (mc_id, mc_files) = marker(&mc).expect("ingest wrote complete.json");
+    assert_eq!(mc_files, ["r01.mcap", "v01.mcap"]);
+    assert_ne!(mc_id, id);
+    let (twin_id, twin_files) =
+        marker(&root.path().join("twin/camp")).expect("synth wrote complete.json");
+    assert_eq!(
+        twin_files,
+        ["campaign.toml", "r01.csv", "truth.json", "v01.bin"]
+    );
+    assert_ne!(twin_id, mc_id);
+
+    // A later identify into the same folder that fails (no identify run) after it started
+    // writing there: the marker is gone, the folder is recognisably incomplete.
+    let camp = campaign(
+        &root.path().join("v"),
+        "[[run]]\nid = \"r01\"\nfile = \"r01.csv\"\nrole = \"validate\"\n",
+    );
+    let o = pendulum()
+        .arg("identify")
+        .arg(&camp)
+        .arg("--out")
+        .arg(&idr)
+        .args(["--np", "10", "--generations", "2", "--quiet"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1), "{:?}", text(&o));
+    assert!(!idr.join("complete.json").exists(), "a stale marker stayed");
+    assert!(
+        idr.join("params.parquet").exists(),
+        "the earlier tables stay"
+    );
+
+    // simulate: one file; its own stale temporaries go, another output's stay.
+    let sims = root.path().join("sims");
+    std::fs::create_dir_all(&sims).unwrap();
+    let mut done = std::process::Command::new("true").spawn().unwrap();
+    let dead = done.id();
+    done.wait().unwrap();
+    let own = format!(".sim.parquet.{dead}-0.tmp");
+    let others = [
+        format!(".other.parquet.{dead}-0.tmp"),
+        format!(".sim.parquet.bak.{dead}-0.tmp"),
+    ];
+    for n in others.iter().chain([&own]) {
+        seed_old(&sims, n);
+    }
+    let o = pendulum()
+        .args(["simulate", "--t-end", "20", "--out"])
+        .arg(sims.join("sim.parquet"))
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{:?}", text(&o));
+    assert!(
+        !sims.join(&own).exists(),
+        "simulate's own stale temp stayed"
+    );
+    for n in &others {
+        assert!(sims.join(n).exists(), "{n} is not simulate's to remove");
+    }
+    let sim_ids = invocation_ids(&sims);
+    assert_eq!(sim_ids.len(), 1);
+
+    // replay: one MCAP carrying the id; its own stale temporaries go.
+    let overlay = sims.join("overlay.mcap");
+    let own = format!(".overlay.mcap.{dead}-2.tmp");
+    seed_old(&sims, &own);
+    let o = pendulum()
+        .arg("replay")
+        .arg(mc.join("r01.mcap"))
+        .arg("--params")
+        .arg(idr.join("params.parquet"))
+        .args(["--model", "reference", "--out"])
+        .arg(&overlay)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{:?}", text(&o));
+    assert!(!sims.join(&own).exists(), "replay's own stale temp stayed");
+    for n in &others {
+        assert!(sims.join(n).exists(), "{n} is not replay's to remove");
+    }
+    let log = pendulum_log::read_run(&overlay).unwrap();
+    let replay_id = log.metadata["replay"]["invocation_id"].clone();
+    assert!(
+        !replay_id.is_empty() && replay_id != id && Some(&replay_id) != sim_ids.values().next(),
+        "{replay_id}"
+    );
+}
+
+/// Issue 13 item 7 (the rest): `synth` wrote `campaign.toml` and `truth.json` through the fixed
+/// names `campaign.tmp` and `truth.tmp`, so two synths into one folder truncated and renamed
+/// away each other's, and a user's `campaign.tmp` was taken. Its temporary names are now unique
+/// to the process (`.campaign.toml.<pid>-<n>.tmp`), it leaves none, and it removes only its own
+/// stale ones: not a user's `campaign.tmp`, not another program output's temporary file.
+#[test]
+fn regression_issue_13_synth_temporary_names_are_its_own() {
+    let root = tempfile::tempdir().unwrap();
+    let out = root.path().join("twin");
+    std::fs::create_dir_all(&out).unwrap();
+    let mut done = std::process::Command::new("true").spawn().unwrap();
+    let dead = done.id();
+    done.wait().unwrap();
+    let users = ["campaign.tmp", "truth.tmp"];
+    for n in users {
+        std::fs::write(out.join(n), "mine").unwrap();
+    }
+    let stale = [
+        format!(".campaign.toml.{dead}-0.tmp"),
+        format!(".r01.csv.{dead}-3.tmp"),
+    ];
+    let foreign = format!(".params.parquet.{dead}-0.tmp");
+    for n in stale.iter().chain([&foreign]) {
+        seed_old(&out, n);
+    }
+    let case = root.path().join("case.toml");
+    std::fs::write(
+        &case,
+        "name = \"t\"\nseed = 3\n[rig]\nm_kg = 1.46\nl_m = 0.265\ncrank_r_m = 0.0725\n\
+         rod_L_m = 0.575\nr_b_m = 0.01225\n[truth]\nb_n_s_m = 0.5\nmu = 0.15\n\
+         [[run]]\nid = \"r01\"\nomega_hz = 1.54\nrole = \"identify\"\nformat = \"serial\"\n\
+         theta0_rad = 0.5\nfree_s = 1\nforced_s = 4\n",
+    )
+    .unwrap();
+    let o = pendulum()
+        .arg("synth")
+        .arg(&case)
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{:?}", text(&o));
+    for n in users {
+        assert_eq!(
+            std::fs::read_to_string(out.join(n)).unwrap(),
+            "mine",
+            "{n} is not synth's"
+        );
+    }
+    for n in &stale {
+        assert!(!out.join(n).exists(), "{n}: synth's own stale temp stayed");
+    }
+    assert!(out.join(&foreign).exists(), "not synth's to remove");
+    assert_eq!(
+        tree(&out),
+        [
+            format!(".params.parquet.{dead}-0.tmp"),
+            "campaign.tmp".to_string(),
+            "campaign.toml".to_string(),
+            "complete.json".to_string(),
+            "r01.csv".to_string(),
+            "truth.json".to_string(),
+            "truth.tmp".to_string(),
+        ],
+        "no temporary file of synth's left"
+    );
+}
+
+/// Issue 13 item 10 (the rest): MCAP files of two campaigns in one folder were fitted together
+/// without a word (one set of damping parameters for two rigs or days). `identify` and
+/// `validate` refuse them, naming both campaigns and their files, before any fit or output;
+/// `--mix-campaigns` asks for it on purpose.
+#[test]
+fn regression_issue_13_mcaps_of_two_campaigns_are_not_fitted_together_unless_asked() {
+    let root = tempfile::tempdir().unwrap();
+    let mixed = root.path().join("mixed");
+    std::fs::create_dir_all(&mixed).unwrap();
+    for (name, id, role) in [
+        ("day-one", "r01", "identify"),
+        ("day-two", "v01", "validate"),
+    ] {
+        let case = root.path().join(format!("{name}.toml"));
+        std::fs::write(
+            &case,
+            format!(
+                "name = \"{name}\"\nseed = 3\n[rig]\nm_kg = 1.46\nl_m = 0.265\n\
+                 crank_r_m = 0.0725\nrod_L_m = 0.575\nr_b_m = 0.01225\n[truth]\nb_n_s_m = 0.5\n\
+                 mu = 0.15\n[[run]]\nid = \"{id}\"\nomega_hz = 1.54\nrole = \"{role}\"\n\
+                 format = \"serial\"\ntheta0_rad = 0.5\nfree_s = 2\nforced_s = 8\n"
+            ),
+        )
+        .unwrap();
+        let camp = root.path().join(name);
+        let mc = root.path().join(format!("{name}-mc"));
+        let o = pendulum()
+            .arg("synth")
+            .arg(&case)
+            .arg(&camp)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{:?}", text(&o));
+        let o = pendulum()
+            .arg("ingest")
+            .arg(&camp)
+            .arg("--out")
+            .arg(&mc)
+            .arg("--quiet")
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{:?}", text(&o));
+        let f = format!("{id}.mcap");
+        std::fs::copy(mc.join(&f), mixed.join(&f)).unwrap();
+    }
+    let identify = |extra: &[&str]| {
+        pendulum()
+            .arg("identify")
+            .arg(&mixed)
+            .arg("--out")
+            .arg(root.path().join("out"))
+            .args(["--np", "10", "--generations", "2", "--quiet"])
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    let o = identify(&[]);
+    let (stdout, stderr) = text(&o);
+    assert_eq!(o.status.code(), Some(1), "{stdout}{stderr}");
+    for s in [
+        "`day-one` (r01.mcap)",
+        "`day-two` (v01.mcap)",
+        "--mix-campaigns",
+    ] {
+        assert!(stderr.contains(s), "{s:?} in {stderr}");
+    }
+    assert!(
+        !root.path().join("out/params.parquet").exists(),
+        "nothing fitted"
+    );
+    let o = identify(&["--mix-campaigns"]);
+    assert!(o.status.success(), "{:?}", text(&o));
+    assert!(root.path().join("out/params.parquet").exists());
+}
+
+/// Issue 13 item 9 (the rest): a capture with 19 MB of header lines was read into memory
+/// (94 MB for ingest), a `campaign.toml` with a 19 MB name took 170 MB. The serial header is
+/// bounded (64 KiB, a firmware header is ~150 bytes), so is a header line (1 KiB) and
+/// `campaign.toml` (1 MiB, lines of 64 KiB): each refused before it is held, naming the file,
+/// the line and the byte offset.
+#[test]
+fn regression_issue_13_huge_headers_are_refused_up_front() {
+    let rows = swing(100, 1_000_000);
+    let good = serial_bytes(&rows, &Header::serial_v1());
+    let mut huge = Vec::new();
+    for i in 0..19_000 {
+        huge.extend_from_slice(format!("# k{i}={}\n", "x".repeat(1000)).as_bytes());
+    }
+    huge.extend_from_slice(&good);
+    let e = SerialReader::new(&huge[..], "huge.csv", ReadOptions::default())
+        .err()
+        .expect("refused")
+        .to_string();
+    assert!(
+        e.contains("huge.csv") && e.contains("65536") && e.contains("line 66, byte 66"),
+        "{e}"
+    );
+    // One line too long: its number and where it starts.
+    let text = String::from_utf8(good.clone()).unwrap();
+    let long = text.replacen(
+        "# encoder_cpr=4096",
+        &format!("# note={}", "y".repeat(5000)),
+        1,
+    );
+    let e = SerialReader::new(long.as_bytes(), "long.csv", ReadOptions::default())
+        .err()
+        .expect("refused")
+        .to_string();
+    assert!(
+        e.contains("long.csv") && e.contains("header line 2 (from byte 21)"),
+        "{e}"
+    );
+    // A long header within the bound still reads.
+    let notes = text.replacen(
+        "# encoder_cpr=4096",
+        &format!("# note={}\n# encoder_cpr=4096", "z".repeat(900)),
+        1,
+    );
+    let (samples, _) = read_capture(notes.as_bytes(), false);
+    assert_eq!(samples.len(), 200);
+
+    let root = tempfile::tempdir().unwrap();
+    let camp = campaign(
+        root.path(),
+        "[[run]]\nid = \"r01\"\nfile = \"r01.csv\"\nrole = \"identify\"\n",
+    );
+    let toml = camp.join("campaign.toml");
+    let base = std::fs::read_to_string(&toml).unwrap();
+    std::fs::write(&toml, format!("{base}# {}\n", "n".repeat(2 << 20))).unwrap();
+    let e = Campaign::load(&camp).expect_err("refused").to_string();
+    assert!(
+        e.contains("campaign.toml") && e.contains("more than 1048576 bytes"),
+        "{e}"
+    );
+    let lines = base.lines().count();
+    std::fs::write(&toml, format!("{base}# {}\n", "n".repeat(100_000))).unwrap();
+    let e = Campaign::load(&camp).expect_err("refused").to_string();
+    assert!(
+        e.contains(&format!("line {}, byte {}", lines + 1, base.len()))
+            && e.contains("100002 bytes"),
+        "{e}"
+    );
+    std::fs::write(&toml, format!("{base}# {}\n", "n".repeat(1000))).unwrap();
+    assert!(
+        Campaign::load(&camp).is_ok(),
+        "a long comment within the bound loads"
+    );
 }

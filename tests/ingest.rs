@@ -483,16 +483,31 @@ fn decode_clean(path: &Path) -> (Vec<(String, String)>, Vec<Rec>) {
     }
 }
 
-/// No temporary or partial files in an ingest output folder: exactly `<id>.mcap` for `ids`.
+/// No temporary or partial files in an ingest output folder: exactly `<id>.mcap` for `ids`,
+/// and the completion marker naming them when every run got in (issue 13: none when a run
+/// failed).
 fn assert_out_dir_holds(out: &Path, ids: &[&str]) {
+    assert_out_dir_holds_marked(out, ids, true);
+}
+
+fn assert_out_dir_holds_marked(out: &Path, ids: &[&str], complete: bool) {
     let mut names: Vec<String> = std::fs::read_dir(out)
         .unwrap()
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
         .filter(|n| !n.ends_with(".expected.json"))
         .collect();
     names.sort();
-    let mut want: Vec<String> = ids.iter().map(|id| format!("{id}.mcap")).collect();
-    want.sort();
+    let mut mcaps: Vec<String> = ids.iter().map(|id| format!("{id}.mcap")).collect();
+    mcaps.sort();
+    let mut want = mcaps.clone();
+    if complete {
+        want.push("complete.json".into());
+        want.sort();
+        let marker: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("complete.json")).unwrap())
+                .unwrap();
+        assert_eq!(marker["files"], serde_json::json!(mcaps), "{marker}");
+    }
     assert_eq!(names, want, "files in {}", out.display());
 }
 
@@ -1433,7 +1448,7 @@ fn runs_that_cannot_be_read_fail_alone() {
     assert!(r04.contains("empty.csv") && r04.contains("empty"), "{r04}");
     let r05 = row("r05");
     assert!(r05.contains("broken.bin") && r05.contains("CRC"), "{r05}");
-    assert_out_dir_holds(&out, &["r01"]);
+    assert_out_dir_holds_marked(&out, &["r01"], false);
     let log = read_run(&out.join("r01.mcap")).unwrap();
     assert_eq!((log.encoder.len(), log.accel.len()), (400, 400));
 
@@ -1447,7 +1462,7 @@ fn runs_that_cannot_be_read_fail_alone() {
         .map(|r| r.run_id.as_str())
         .collect();
     assert_eq!(failed, ["r02", "r03", "r04", "r05"]);
-    assert_out_dir_holds(&dir.path().join("out2"), &["r01"]);
+    assert_out_dir_holds_marked(&dir.path().join("out2"), &["r01"], false);
 
     std::fs::write(camp.join("campaign.toml"), &good).unwrap();
     let (code, stdout, stderr) = ingest_binary(&camp, &dir.path().join("out3"));
@@ -1634,4 +1649,85 @@ fn regression_issue_16_bursty_stamps_through_ingest() {
     assert!((rate / rate_hz - 1.0).abs() < 0.01, "rate {rate} Hz");
     let tps = pendulum_explain::turning_points(t, &runs[0].theta_rad);
     assert!(tps.len() > 40, "{} turning points", tps.len());
+}
+
+/// Issue 13 (a public thesis' 150 Hz recording): a CSV without a column-name line was refused
+/// ("the file's columns must be named"). Columns may be given by 0-based index (`time_column =
+/// 0`, `angle_column = 1`): with every column so given, a first line of numbers is the first
+/// sample, and every line is read; an index past the file's columns is refused naming it; a
+/// named column still needs the column-name line, and the error says how to do without one.
+#[test]
+fn issue_13_a_csv_without_a_header_line_reads_columns_by_index() {
+    let dir = tempfile::tempdir().unwrap();
+    let camp = dir.path().join("camp");
+    std::fs::create_dir_all(&camp).unwrap();
+    let n = 600;
+    let rows: Vec<(f64, f64)> = (0..n)
+        .map(|k| {
+            let t = k as f64 / 150.0;
+            (t, 20.0 * (-0.1 * t).exp() * (TAU * 0.9 * t).cos())
+        })
+        .collect();
+    let csv: String = rows
+        .iter()
+        .map(|(t, a)| format!("{t:.6},{a:.5},7\n"))
+        .collect();
+    std::fs::write(camp.join("thesis.csv"), &csv).unwrap();
+    let toml = |cols: &str| {
+        format!(
+            "name = \"thesis\"\n[[run]]\nid = \"hold\"\nfile = \"thesis.csv\"\nrole = \"identify\"\n\
+             format = \"timeseries\"\nangle_unit = \"deg\"\n{cols}\n"
+        )
+    };
+    std::fs::write(
+        camp.join("campaign.toml"),
+        toml("time_column = 0\nangle_column = 1"),
+    )
+    .unwrap();
+    let out = dir.path().join("out");
+    let summary = ingest::run(&camp, &out, false).unwrap();
+    assert_eq!(summary.failed(), 0, "{summary}");
+    let log = read_run(&out.join("hold.mcap")).unwrap();
+    assert_eq!(log.encoder.len(), n, "the first line is a sample too");
+    for (e, (t, a)) in log.encoder.iter().zip(&rows) {
+        assert!((e.t_s - t).abs() < 1e-6, "{} vs {t}", e.t_s);
+        assert!((e.theta_rad - a.to_radians()).abs() < 1e-6);
+    }
+    // With a column-name line, an index reads the same column.
+    std::fs::write(camp.join("thesis.csv"), format!("time,angle,x\n{csv}")).unwrap();
+    std::fs::write(
+        camp.join("campaign.toml"),
+        toml("time_column = \"time\"\nangle_column = 1"),
+    )
+    .unwrap();
+    let summary = ingest::run(&camp, &out, false).unwrap();
+    assert_eq!(summary.failed(), 0, "{summary}");
+    assert_eq!(read_run(&out.join("hold.mcap")).unwrap().encoder.len(), n);
+
+    // Refusals name the problem.
+    std::fs::write(camp.join("thesis.csv"), &csv).unwrap();
+    for (cols, want) in [
+        (
+            "time_column = 0\nangle_column = 3",
+            "column index 3 (key `angle_column`, 0-based) is past the 3 columns",
+        ),
+        (
+            "time_column = \"t\"\nangle_column = 1",
+            "or give every column by its 0-based index",
+        ),
+        (
+            "time_column = 0\nangle_column = -1",
+            "a 0-based column index",
+        ),
+    ] {
+        std::fs::write(camp.join("campaign.toml"), toml(cols)).unwrap();
+        let text = match ingest::run(&camp, &out, false) {
+            Ok(s) => s.to_string(),
+            Err(e) => e.to_string(),
+        };
+        assert!(
+            text.contains(want) && text.contains("hold"),
+            "{cols}: {text}"
+        );
+    }
 }

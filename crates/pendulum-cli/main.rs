@@ -1,8 +1,10 @@
 //! The `pendulum` binary: parses arguments, calls the library crates, prints results and errors
 //! (with their chain), maps failures to exit codes. No logic lives here.
 
+use std::io::Write as _;
 use std::path::PathBuf;
 use std::process::ExitCode;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use clap::{Parser, Subcommand};
 use pendulum_jobs::{demo, discover, identify, ingest, simulate, synth};
@@ -99,6 +101,9 @@ struct IdentifyArgs {
     /// (into OUT/free_segments/).
     #[arg(long)]
     free_segments: bool,
+    /// Fit MCAP files of different campaigns together (refused otherwise).
+    #[arg(long)]
+    mix_campaigns: bool,
     /// No progress bar.
     #[arg(long)]
     quiet: bool,
@@ -120,6 +125,9 @@ struct ValidateArgs {
     /// Pipeline file (default: the built-in pipelines/validate.toml).
     #[arg(long)]
     pipeline: Option<PathBuf>,
+    /// Validate on MCAP files of different campaigns together (refused otherwise).
+    #[arg(long)]
+    mix_campaigns: bool,
 }
 
 #[derive(clap::Args)]
@@ -209,6 +217,39 @@ struct DemoArgs {
     quick: bool,
 }
 
+/// Set once stdout's reader has gone (`pendulum … | head`): the rest of the report is dropped.
+static STDOUT_GONE: AtomicBool = AtomicBool::new(false);
+
+/// Writes part of the report to stdout. A reader that went away (a broken pipe: `| head` has
+/// what it wanted) is not the job's failure: the rest of the report is dropped quietly and the
+/// exit code stays the job's own (0 when it succeeded; `print!` used to panic there, exit 101).
+/// Any other write error (a full disk behind `> file`) is one, and is returned.
+fn emit(args: std::fmt::Arguments<'_>) -> anyhow::Result<()> {
+    if STDOUT_GONE.load(Ordering::Relaxed) {
+        return Ok(());
+    }
+    let mut out = std::io::stdout().lock();
+    match out.write_fmt(args).and_then(|()| out.flush()) {
+        Ok(()) => Ok(()),
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => {
+            STDOUT_GONE.store(true, Ordering::Relaxed);
+            Ok(())
+        }
+        Err(e) => Err(anyhow::anyhow!("writing the report to stdout: {e}")),
+    }
+}
+
+/// `print!` through [`emit`].
+macro_rules! out {
+    ($($arg:tt)*) => { emit(format_args!($($arg)*))? };
+}
+
+/// `println!` through [`emit`].
+macro_rules! outln {
+    () => { emit(format_args!("\n"))? };
+    ($($arg:tt)*) => { emit(format_args!("{}\n", format_args!($($arg)*)))? };
+}
+
 fn main() -> ExitCode {
     // Fixes the invocation's id and start now: temporary files in OUT older than it are not ours.
     pendulum_jobs::invocation();
@@ -218,12 +259,14 @@ fn main() -> ExitCode {
         Err(e) => {
             // Errors that name a file say `{path}: {source}` and keep the source in the chain:
             // a cause already said above is not printed again (it read "Not a directory" twice).
+            // Written with `writeln!`, whose failure (stderr closed too) is ignored, not a panic.
+            let mut err = std::io::stderr().lock();
             let mut said = e.to_string();
-            eprintln!("error: {said}");
+            let _ = writeln!(err, "error: {said}");
             for cause in e.chain().skip(1) {
                 let cause = cause.to_string();
                 if !said.contains(&cause) {
-                    eprintln!("  caused by: {cause}");
+                    let _ = writeln!(err, "  caused by: {cause}");
                     said.push_str(&cause);
                 }
             }
@@ -244,11 +287,11 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 tol: a.tol,
                 out: a.out,
             })?;
-            println!("{summary}");
+            outln!("{summary}");
         }
         Command::Ingest(a) => {
             let summary = ingest::run(&a.campaign_dir, &a.out, !a.quiet)?;
-            print!("{summary}");
+            out!("{summary}");
             let failed = summary.failed();
             if failed > 0 {
                 anyhow::bail!(
@@ -259,7 +302,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         }
         Command::Synth(a) => {
             let s = synth::run(&a.case, &a.out_dir)?;
-            println!(
+            outln!(
                 "wrote {} runs to {} (campaign {}, truth {})",
                 s.truth_data.runs.len(),
                 s.dir.display(),
@@ -267,7 +310,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 s.truth.display()
             );
             for r in &s.truth_data.runs {
-                println!(
+                outln!(
                     "  {:<8} {:<6} Ω = {:.5} Hz  t0 = {:.4} s  θ0 = {:+.4} rad  θ̇0 = {:+.4} rad/s  steady {}",
                     r.id, format!("{:?}", r.format).to_lowercase(), r.omega_real_hz, r.t0_s, r.theta0_rad, r.theta_dot0_rad_s, r.steady
                 );
@@ -288,11 +331,12 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                     threads: a.threads,
                     window_s: a.window_s,
                     no_early_abandon: a.no_early_abandon,
+                    mix_campaigns: a.mix_campaigns,
                 },
                 progress: !a.quiet,
                 free_segments: a.free_segments,
             })?;
-            print!("{s}");
+            out!("{s}");
         }
         Command::Discover(a) => {
             let s = discover::run(&discover::DiscoverJob {
@@ -308,7 +352,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 seed: a.seed,
                 progress: !a.quiet,
             })?;
-            print!("{s}");
+            out!("{s}");
         }
         Command::Validate(a) => {
             let s = identify::validate(&identify::ValidateJob {
@@ -317,48 +361,51 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 model: a.model,
                 out: a.out,
                 pipeline: a.pipeline,
+                mix_campaigns: a.mix_campaigns,
             })?;
-            print!("{s}");
+            out!("{s}");
         }
-        Command::Bifurcate(a) => print!("{}", pendulum_jobs::bifurcate::run(&a)?),
-        Command::Zones(a) => print!("{}", pendulum_jobs::zones::run(&a)?),
-        Command::Replay(a) => print!("{}", pendulum_jobs::replay::run(&a)?),
+        Command::Bifurcate(a) => out!("{}", pendulum_jobs::bifurcate::run(&a)?),
+        Command::Zones(a) => out!("{}", pendulum_jobs::zones::run(&a)?),
+        Command::Replay(a) => out!("{}", pendulum_jobs::replay::run(&a)?),
         Command::Demo(a) => {
-            println!(
+            outln!(
                 "Study configurations (R = 0.7, λ = 0.126), {0}×{0} starts each, steady states:",
                 a.grid
             );
             let rows = demo::run(a.grid)?;
-            print!("{:<10} {:>6}", "model", "omega");
+            out!("{:<10} {:>6}", "model", "omega");
             for c in SteadyClass::ALL {
-                print!(" {:>12}", c.as_str());
+                out!(" {:>12}", c.as_str());
             }
-            println!();
+            outln!();
             for r in rows {
-                print!("{:<10} {:>6.3}", r.model, r.omega);
+                out!("{:<10} {:>6.3}", r.model, r.omega);
                 for n in r.counts {
-                    print!(" {n:>12}");
+                    out!(" {n:>12}");
                 }
-                println!();
+                outln!();
             }
             if !a.quick {
-                println!("\nDigital twin campaign (truth: a = 0, b = 0.5 N·s/m, μ = 0.15) → raw captures → MCAP → identify:");
+                outln!("\nDigital twin campaign (truth: a = 0, b = 0.5 N·s/m, μ = 0.15) → raw captures → MCAP → identify:");
                 let c = demo::campaign(&a.out, a.generations, true)?;
-                print!("{}", c.ingest);
-                print!("{}", c.identify);
-                println!(
+                out!("{}", c.ingest);
+                out!("{}", c.identify);
+                outln!(
                     "truth: a = {}, b = {}, μ = {}",
-                    c.truth.params.a_kg_m, c.truth.params.b_n_s_m, c.truth.params.mu
+                    c.truth.params.a_kg_m,
+                    c.truth.params.b_n_s_m,
+                    c.truth.params.mu
                 );
-                println!("\nA second twin campaign with an effect hidden in it (named at the end) → discover:");
+                outln!("\nA second twin campaign with an effect hidden in it (named at the end) → discover:");
                 let d = demo::hidden_effect(&a.out, true)?;
-                print!("{d}");
-                println!("(hidden: horizontal_base, δ = 0.04 rad)");
-                println!(
+                out!("{d}");
+                outln!("(hidden: horizontal_base, δ = 0.04 rad)");
+                outln!(
                     "\nWhere does it rotate? The study's dry-friction vs linear model over ω × R:"
                 );
                 let z = pendulum_jobs::zones::demo_comparison(&a.out.join("zones"), true)?;
-                print!("{z}");
+                out!("{z}");
             }
         }
     }

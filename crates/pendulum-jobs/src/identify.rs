@@ -15,7 +15,7 @@ use pendulum_process::{Role, RunData};
 
 use crate::inputs::Inputs;
 use crate::outputs::{prepare_out_dir, removed_note, write_outputs_checked, OutputSummary, TABLES};
-use crate::runs::load_runs;
+use crate::runs::load_runs_mixing;
 use crate::JobError;
 
 /// The built-in pipelines (the same text as `pipelines/*.toml`).
@@ -34,6 +34,8 @@ pub struct FitOverrides {
     pub threads: Option<usize>,
     pub window_s: Option<f64>,
     pub no_early_abandon: bool,
+    /// Fit MCAP files of different campaigns together (refused otherwise, naming them).
+    pub mix_campaigns: bool,
 }
 
 /// What to identify.
@@ -257,7 +259,7 @@ pub fn run(job: &IdentifyJob) -> Result<OutputSummary, JobError> {
     }
     let inputs = checked_inputs(inputs, &job.input, &job.out)?;
     let removed = prepare_out_dir(&job.out)?;
-    let runs: Vec<RunData> = load_runs(&job.input)?;
+    let runs: Vec<RunData> = load_runs_mixing(&job.input, job.overrides.mix_campaigns)?;
     if !runs.iter().any(|r| r.role == Role::Identify) {
         return Err(JobError::Invalid(format!(
             "{}: no run has role = \"identify\"",
@@ -308,7 +310,7 @@ pub fn run(job: &IdentifyJob) -> Result<OutputSummary, JobError> {
             summary.text += &format!(
                 "\nfree segments: none of at least {FREE_SEGMENT_MIN_S} s before a shaker start in an identify run; not fitted\n"
             );
-            return Ok(summary);
+            return completed(&job.out, "pendulum identify", summary);
         }
         let n = free.len();
         let mut fctx = Context::new(free);
@@ -327,6 +329,19 @@ pub fn run(job: &IdentifyJob) -> Result<OutputSummary, JobError> {
         summary.tables.extend(fs.tables);
         summary.plots.extend(fs.plots);
     }
+    completed(&job.out, "pendulum identify", summary)
+}
+
+/// Marks OUT complete (the last write: [`crate::outputs::mark_complete`]) naming the tables
+/// and plots of `summary`.
+fn completed(out: &Path, command: &str, summary: OutputSummary) -> Result<OutputSummary, JobError> {
+    let files: Vec<_> = summary
+        .tables
+        .iter()
+        .chain(&summary.plots)
+        .cloned()
+        .collect();
+    crate::outputs::mark_complete(out, command, &files)?;
     Ok(summary)
 }
 
@@ -364,6 +379,8 @@ pub struct ValidateJob {
     pub model: Option<String>,
     pub out: PathBuf,
     pub pipeline: Option<PathBuf>,
+    /// Validate on MCAP files of different campaigns together (refused otherwise).
+    pub mix_campaigns: bool,
 }
 
 /// Runs the validate pipeline with a given model.
@@ -379,7 +396,7 @@ pub fn validate(job: &ValidateJob) -> Result<OutputSummary, JobError> {
     }
     let inputs = checked_inputs(inputs, &job.input, &job.out)?;
     let removed = prepare_out_dir(&job.out)?;
-    let runs = load_runs(&job.input)?;
+    let runs = load_runs_mixing(&job.input, job.mix_campaigns)?;
     if !runs.iter().any(|r| r.role == Role::Validate) {
         return Err(JobError::Invalid(format!(
             "{}: no run has role = \"validate\"",
@@ -390,14 +407,15 @@ pub fn validate(job: &ValidateJob) -> Result<OutputSummary, JobError> {
     ctx.notes.extend(removed_note(&removed));
     ctx.given = Some(given);
     pipeline.run(&mut ctx)?;
-    write_outputs_checked(
+    let summary = write_outputs_checked(
         &ctx,
         &job.out,
         &pipeline_text,
         "pendulum validate",
         started.elapsed().as_secs_f64(),
         &inputs,
-    )
+    )?;
+    completed(&job.out, "pendulum validate", summary)
 }
 
 /// `inputs` plus the files of the run source `input`, after checking that none of the tables

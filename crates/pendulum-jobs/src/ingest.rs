@@ -8,7 +8,9 @@ use pendulum_log::{
     parse_rfc3339_utc_ns, AccelMsg, EncoderMsg, RunLogOptions, METADATA_CAPTURE_HEADER,
     METADATA_RUN,
 };
-use pendulum_rig::{Campaign, CaptureReader, IngestStats, Location, ReadOptions, RunSpec, Sample};
+use pendulum_rig::{
+    Campaign, CaptureReader, IngestStats, Location, ReadOptions, RunSpec, Sample, TimelinePlan,
+};
 use rayon::prelude::*;
 
 use crate::inputs::Inputs;
@@ -119,8 +121,12 @@ impl std::fmt::Display for IngestSummary {
 
 /// Smallest unwrapped clock value among the first samples (frames of the two SD streams may be
 /// slightly out of order), so that every t_s is ≥ 0.
-fn first_t_us(spec: &RunSpec, opts: ReadOptions) -> Result<Option<u64>, JobError> {
-    let mut r = CaptureReader::open_run(spec, opts)?;
+fn first_t_us(
+    spec: &RunSpec,
+    opts: ReadOptions,
+    plan: Option<&TimelinePlan>,
+) -> Result<Option<u64>, JobError> {
+    let mut r = CaptureReader::open_run_planned(spec, opts, plan)?;
     let mut min: Option<u64> = None;
     for _ in 0..2000 {
         match r.next_sample()? {
@@ -178,12 +184,41 @@ fn has_accelerometer(spec: &RunSpec) -> bool {
 }
 
 fn ingest_run(c: &Campaign, spec: &RunSpec, out_dir: &Path) -> Result<IngestRow, JobError> {
+    let mut plan: Option<TimelinePlan> = None;
+    for reading in 1..=pendulum_rig::capture::MAX_READINGS {
+        let last = reading == pendulum_rig::capture::MAX_READINGS;
+        match ingest_reading(c, spec, out_dir, plan.as_ref(), last)? {
+            Reading::Done(row) => return Ok(*row),
+            Reading::Again(more) => match &mut plan {
+                Some(p) => p.merge(more),
+                None => plan = Some(more),
+            },
+        }
+    }
+    unreachable!("the last reading is always done")
+}
+
+/// One reading of a capture into its MCAP.
+enum Reading {
+    Done(Box<IngestRow>),
+    /// The reading kept blocks off the timeline: its MCAP was discarded (never under the final
+    /// name), to be read again dropping them.
+    Again(TimelinePlan),
+}
+
+fn ingest_reading(
+    c: &Campaign,
+    spec: &RunSpec,
+    out_dir: &Path,
+    plan: Option<&TimelinePlan>,
+    last: bool,
+) -> Result<Reading, JobError> {
     let opts = ReadOptions {
         g_m_s2: c.g_m_s2,
         ..ReadOptions::default()
     };
-    let t0 = first_t_us(spec, opts)?.unwrap_or(0);
-    let mut reader = CaptureReader::open_run(spec, opts)?;
+    let t0 = first_t_us(spec, opts, plan)?.unwrap_or(0);
+    let mut reader = CaptureReader::open_run_planned(spec, opts, plan)?;
     let mut warnings = Vec::new();
     // A time base the reader had to rebuild (bursty stamps) is news the user must see, not only
     // a header key in the MCAP.
@@ -242,31 +277,38 @@ fn ingest_run(c: &Campaign, spec: &RunSpec, out_dir: &Path) -> Result<IngestRow,
             })?,
         }
     }
+    if !last {
+        if let Some(more) = reader.timeline_plan() {
+            // Unfinished: the writer removes its temporary file.
+            drop(w);
+            return Ok(Reading::Again(more));
+        }
+    }
     let stats = reader.stats().clone();
     warnings.extend(stats.warnings.iter().cloned());
     if let Some(why) = stats.failure() {
         // Dropped unfinished: the writer removes its temporary file, so no near-empty MCAP
         // takes the final name; the row keeps the stats so that the skips are listed.
         drop(w);
-        return Ok(IngestRow {
+        return Ok(Reading::Done(Box::new(IngestRow {
             run_id: spec.id.clone(),
             format: reader.format().to_string(),
             mcap: None,
             stats: Some(stats),
             error: Some(format!("{}: failed run: {why}", spec.file.display())),
             warnings,
-        });
+        })));
     }
     w.write_stats(&stats_json(&stats, reader.format()))?;
     let summary = w.finish()?;
-    Ok(IngestRow {
+    Ok(Reading::Done(Box::new(IngestRow {
         run_id: spec.id.clone(),
         format: reader.format().to_string(),
         mcap: Some(summary.path),
         stats: Some(stats),
         error: None,
         warnings,
-    })
+    })))
 }
 
 /// Where a run's MCAP goes (the id is a safe file name: [`pendulum_rig::names`]).
@@ -340,6 +382,12 @@ pub fn run(dir: &Path, out_dir: &Path, show_progress: bool) -> Result<IngestSumm
         })
         .collect();
     bar.finish_and_clear();
+    // Every run in: the folder is complete (the marker is written last; `prepare_out_dir`
+    // removed any earlier one). A failed run leaves it without one.
+    if rows.iter().all(|r| r.error.is_none()) {
+        let files: Vec<PathBuf> = rows.iter().filter_map(|r| r.mcap.clone()).collect();
+        crate::outputs::mark_complete(out_dir, "pendulum ingest", &files)?;
+    }
     Ok(IngestSummary {
         campaign: c.name.clone(),
         rows,

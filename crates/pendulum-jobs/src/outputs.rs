@@ -53,6 +53,10 @@ const ALL_EFFECT_PARAMS: [FitParam; 8] = [
 /// writable (a probe file created and removed: an unwritable OUT used to fail only after the
 /// fit), and removes this program's stale temporary files from it ([`remove_stale_temps`]).
 /// Returns the files removed.
+///
+/// The folder's completion marker ([`COMPLETE_MARKER`]) goes first: from here until the command
+/// writes its own ([`mark_complete`]) the folder is recognisably incomplete. PNGs written from
+/// here on carry the invocation id ([`stamp_plots`]).
 pub fn prepare_out_dir(out: &Path) -> Result<Vec<PathBuf>, JobError> {
     let io = |path: &Path| {
         let path = path.to_path_buf();
@@ -64,7 +68,118 @@ pub fn prepare_out_dir(out: &Path) -> Result<Vec<PathBuf>, JobError> {
     let probe = out.join(format!(".write-check.{}-0.tmp", std::process::id()));
     std::fs::File::create_new(&probe).map_err(io(out))?;
     std::fs::remove_file(&probe).map_err(io(&probe))?;
+    stamp_plots();
+    remove_marker(out)?;
     remove_stale_temps(out)
+}
+
+/// The file a result folder holds once the command that wrote it has finished: JSON with the
+/// invocation id its tables (key-value metadata) and PNGs (`tEXt`) carry, the command and the
+/// files it wrote. Written last, atomically; removed first when a command starts writing into
+/// the folder. A folder without it is incomplete (a command was killed, failed, or is still
+/// running there); a table or plot whose invocation id is not the marker's is stale.
+pub const COMPLETE_MARKER: &str = "complete.json";
+
+/// Every PNG this process writes from now on carries its invocation id (`tEXt` chunk
+/// `invocation_id`), as its tables do.
+pub fn stamp_plots() {
+    // The id is ASCII digits, '.' and '-': always valid PNG text.
+    let _ = pendulum_plot::set_png_text("invocation_id", &pendulum_report::invocation().id);
+}
+
+/// Removes `out`'s completion marker, if any.
+pub fn remove_marker(out: &Path) -> Result<(), JobError> {
+    let path = out.join(COMPLETE_MARKER);
+    match std::fs::remove_file(&path) {
+        Ok(()) => Ok(()),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(()),
+        Err(source) => Err(JobError::Io { path, source }),
+    }
+}
+
+/// Writes `out`'s completion marker ([`COMPLETE_MARKER`]) naming `files` (those under `out`,
+/// relative to it): call it last, once every output is in place.
+pub fn mark_complete(out: &Path, command: &str, files: &[PathBuf]) -> Result<PathBuf, JobError> {
+    let mut names: Vec<String> = files
+        .iter()
+        .filter_map(|f| f.strip_prefix(out).ok())
+        .map(|f| f.to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    names.dedup();
+    let json = serde_json::json!({
+        "invocation_id": pendulum_report::invocation().id,
+        "command": command,
+        "pendulum_version": env!("CARGO_PKG_VERSION"),
+        "files": names,
+    });
+    let path = out.join(COMPLETE_MARKER);
+    let mut text = serde_json::to_string_pretty(&json).unwrap_or_default();
+    text.push('\n');
+    write_atomic(&path, text.as_bytes())?;
+    Ok(path)
+}
+
+/// Writes `bytes` to `path` through this program's temporary name (`.NAME.<pid>-<n>.tmp`,
+/// created only if new), synced, then renamed over `path`; the temporary file is removed on
+/// failure.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), JobError> {
+    use std::io::Write as _;
+    static COUNTER: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+    let n = COUNTER.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let name = path
+        .file_name()
+        .map(|f| f.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let tmp = path.with_file_name(format!(".{name}.{}-{n}.tmp", std::process::id()));
+    let io = |source| JobError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let result = std::fs::File::create_new(&tmp)
+        .and_then(|mut f| {
+            f.write_all(bytes)?;
+            f.sync_all()
+        })
+        .and_then(|()| std::fs::rename(&tmp, path));
+    if let Err(e) = result {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(io(e));
+    }
+    Ok(())
+}
+
+/// Removes from `dir` this program's stale temporary files ([`remove_stale_temps`]'s rule) of
+/// the files `names` only: a command writing one file (or a known set) into a folder that is
+/// not its own (`simulate --out ~/x.parquet`) sweeps its own leftovers, nothing else there.
+pub fn remove_stale_temps_of(dir: &Path, names: &[String]) -> Result<Vec<PathBuf>, JobError> {
+    // `.NAME.<pid>-<n>.tmp[.png]`: the NAME (the pid and counter were checked by the sweep).
+    let target = |temp: &str| -> Option<String> {
+        let stem = temp
+            .strip_suffix(".tmp.png")
+            .or_else(|| temp.strip_suffix(".tmp"))?;
+        let (base, _) = stem.strip_prefix('.')?.rsplit_once('.')?;
+        Some(base.to_string())
+    };
+    if !dir.is_dir() {
+        // Nothing there yet: nothing left behind.
+        return Ok(Vec::new());
+    }
+    remove_stale_temps_where(dir, |name| {
+        target(name).is_some_and(|base| names.contains(&base))
+    })
+}
+
+/// [`remove_stale_temps_of`] for the folder of one output file `path` and that file alone.
+pub fn remove_stale_temps_of_file(path: &Path) -> Result<Vec<PathBuf>, JobError> {
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let Some(name) = path.file_name() else {
+        return Ok(Vec::new());
+    };
+    remove_stale_temps_of(dir, &[name.to_string_lossy().into_owned()])
 }
 
 /// Removes from `dir` (not its subfolders) this program's temporary files
@@ -73,6 +188,13 @@ pub fn prepare_out_dir(out: &Path) -> Result<Vec<PathBuf>, JobError> {
 /// run) of a process no longer running, so that a concurrent writer's file is never taken. A
 /// killed `identify` used to leave them for good (up to 116 MB each).
 pub fn remove_stale_temps(dir: &Path) -> Result<Vec<PathBuf>, JobError> {
+    remove_stale_temps_where(dir, |_| true)
+}
+
+fn remove_stale_temps_where(
+    dir: &Path,
+    wanted: impl Fn(&str) -> bool,
+) -> Result<Vec<PathBuf>, JobError> {
     let started = pendulum_report::invocation().started;
     let own = std::process::id();
     let proc_known = Path::new("/proc/self").exists();
@@ -86,6 +208,9 @@ pub fn remove_stale_temps(dir: &Path) -> Result<Vec<PathBuf>, JobError> {
         let Some(pid) = pendulum_report::temp_writer_pid(&name) else {
             continue;
         };
+        if !wanted(&name) {
+            continue;
+        }
         let Ok(md) = e.metadata() else { continue };
         let old = md.modified().is_ok_and(|t| t < started);
         let running = proc_known && Path::new(&format!("/proc/{pid}")).exists();

@@ -113,6 +113,9 @@ pub fn run(a: &ReplayArgs) -> Result<ReplaySummary, JobError> {
     inputs.add("RUN", &a.run);
     inputs.add("--params", &a.params_file);
     inputs.check_output("--out", &a.out)?;
+    // One file, renamed into place whole; an interrupted earlier replay's temporary files of
+    // it go, nothing else in that folder.
+    crate::outputs::remove_stale_temps_of_file(&a.out)?;
     let log = read_run(&a.run)?;
     let rd = run_data_from_log(&log)?;
     if rd.enc_t_s.is_empty() {
@@ -206,6 +209,11 @@ pub fn run(a: &ReplayArgs) -> Result<ReplaySummary, JobError> {
         }
     }
     let mut meta = BTreeMap::new();
+    // The invocation id, as every table carries it.
+    meta.insert(
+        "invocation_id".to_string(),
+        pendulum_report::invocation().id.clone(),
+    );
     meta.insert("model".to_string(), a.model.clone());
     meta.insert(
         "params_file".to_string(),

@@ -25,11 +25,26 @@ pub fn read_capture(spec: &RunSpec, g_m_s2: f64) -> Result<ReadCapture, JobError
         g_m_s2,
         ..ReadOptions::default()
     };
-    let mut reader = CaptureReader::open_run(spec, opts)?;
-    let mut samples = Vec::new();
-    while let Some(s) = reader.next_sample()? {
-        samples.push(s);
-    }
+    // Read again while a reading finds blocks off the timeline longer than the reader's
+    // read-ahead (as `pendulum ingest` does).
+    let mut plan: Option<pendulum_rig::TimelinePlan> = None;
+    let mut reading = 0;
+    let (reader, samples) = loop {
+        reading += 1;
+        let mut reader = CaptureReader::open_run_planned(spec, opts, plan.as_ref())?;
+        let mut samples = Vec::new();
+        while let Some(s) = reader.next_sample()? {
+            samples.push(s);
+        }
+        let more = match reader.timeline_plan() {
+            Some(more) if reading < pendulum_rig::capture::MAX_READINGS => more,
+            _ => break (reader, samples),
+        };
+        match &mut plan {
+            Some(p) => p.merge(more),
+            None => plan = Some(more),
+        }
+    };
     // The rule `pendulum ingest` applies: a run that kept almost nothing is no run to fit.
     if let Some(why) = reader.stats().failure() {
         return Err(JobError::Invalid(format!(
@@ -236,9 +251,16 @@ pub fn source(dir: &Path) -> Result<Source, JobError> {
     Ok(Source::Mcap(files))
 }
 
-/// Loads every run of a campaign or MCAP folder (in parallel).
+/// Loads every run of a campaign or MCAP folder (in parallel). MCAP files of different
+/// campaigns are refused ([`load_runs_mixing`]).
 pub fn load_runs(dir: &Path) -> Result<Vec<RunData>, JobError> {
-    Ok(load_runs_resolved(dir)?
+    load_runs_mixing(dir, false)
+}
+
+/// [`load_runs`]; `mix_campaigns`: MCAP files of different campaigns may be fitted together
+/// (asked for with `--mix-campaigns`), else refused naming the campaigns.
+pub fn load_runs_mixing(dir: &Path, mix_campaigns: bool) -> Result<Vec<RunData>, JobError> {
+    Ok(load_runs_resolved_mixing(dir, mix_campaigns)?
         .into_iter()
         .map(|(rd, _)| rd)
         .collect())
@@ -247,6 +269,59 @@ pub fn load_runs(dir: &Path) -> Result<Vec<RunData>, JobError> {
 /// [`load_runs`] with each run's angle resolution, rad, when its capture states it (see
 /// [`angle_step_rad`]).
 pub fn load_runs_resolved(dir: &Path) -> Result<Vec<(RunData, Option<f64>)>, JobError> {
+    load_runs_resolved_mixing(dir, false)
+}
+
+/// Refuses MCAP files of more than one campaign (their metadata `run.campaign`), unless
+/// `mix_campaigns`: runs of two campaigns (another rig, another day, another pendulum) fitted
+/// as one used to give one set of damping parameters for both without a word. Files without a
+/// campaign name are not counted.
+fn check_one_campaign(
+    dir: &Path,
+    files: &[(PathBuf, Option<String>)],
+    mix_campaigns: bool,
+) -> Result<(), JobError> {
+    let mut by: BTreeMap<&str, Vec<String>> = BTreeMap::new();
+    for (p, c) in files {
+        if let Some(c) = c {
+            by.entry(c.as_str()).or_default().push(
+                p.file_name()
+                    .map(|n| n.to_string_lossy().into_owned())
+                    .unwrap_or_default(),
+            );
+        }
+    }
+    if mix_campaigns || by.len() < 2 {
+        return Ok(());
+    }
+    let list: Vec<String> = by
+        .iter()
+        .map(|(c, f)| {
+            format!(
+                "`{}` ({})",
+                pendulum_rig::names::printable(c),
+                f.iter()
+                    .map(|n| pendulum_rig::names::printable(n))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )
+        })
+        .collect();
+    Err(JobError::Invalid(format!(
+        "{}: the MCAP files hold runs of {} campaigns: {}: refusing to fit them together (one \
+         set of parameters for different rigs or days); `identify` and `validate` take \
+         --mix-campaigns to do it on purpose",
+        dir.display(),
+        by.len(),
+        list.join(" and ")
+    )))
+}
+
+/// [`load_runs_resolved`]; `mix_campaigns` as in [`load_runs_mixing`].
+pub fn load_runs_resolved_mixing(
+    dir: &Path,
+    mix_campaigns: bool,
+) -> Result<Vec<(RunData, Option<f64>)>, JobError> {
     use rayon::prelude::*;
     match source(dir)? {
         Source::Campaign(c) => {
@@ -264,24 +339,43 @@ pub fn load_runs_resolved(dir: &Path) -> Result<Vec<(RunData, Option<f64>)>, Job
                 })
                 .collect()
         }
-        Source::Mcap(files) => files
-            .par_iter()
-            .map(|p| {
-                let log = read_run(p)?;
-                let header: Vec<(String, String)> = log
-                    .metadata
-                    .get(METADATA_CAPTURE_HEADER)
-                    .map(|m| m.clone().into_iter().collect())
-                    .unwrap_or_default();
-                let format = log
-                    .metadata
-                    .get(METADATA_RUN)
-                    .and_then(|m| m.get("format").cloned());
-                let step = angle_step_rad(format.as_deref(), &header);
-                Ok((run_data_from_log(&log)?, step))
-            })
-            .collect(),
+        Source::Mcap(files) => {
+            let loaded: Vec<(RunData, Option<f64>, Option<String>)> = files
+                .par_iter()
+                .map(|p| {
+                    let log = read_run(p)?;
+                    let campaign = log
+                        .metadata
+                        .get(METADATA_RUN)
+                        .and_then(|m| m.get("campaign").cloned());
+                    let (rd, step) = run_of_log(&log)?;
+                    Ok((rd, step, campaign))
+                })
+                .collect::<Result<_, JobError>>()?;
+            let named: Vec<(PathBuf, Option<String>)> = files
+                .iter()
+                .cloned()
+                .zip(loaded.iter().map(|l| l.2.clone()))
+                .collect();
+            check_one_campaign(dir, &named, mix_campaigns)?;
+            Ok(loaded.into_iter().map(|(rd, step, _)| (rd, step)).collect())
+        }
     }
+}
+
+/// An MCAP run log's run data and angle step.
+fn run_of_log(log: &RunLog) -> Result<(RunData, Option<f64>), JobError> {
+    let header: Vec<(String, String)> = log
+        .metadata
+        .get(METADATA_CAPTURE_HEADER)
+        .map(|m| m.clone().into_iter().collect())
+        .unwrap_or_default();
+    let format = log
+        .metadata
+        .get(METADATA_RUN)
+        .and_then(|m| m.get("format").cloned());
+    let step = angle_step_rad(format.as_deref(), &header);
+    Ok((run_data_from_log(log)?, step))
 }
 
 /// One step of a run's angle, rad (2π / counts per revolution), when its capture states it: the

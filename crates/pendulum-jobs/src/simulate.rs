@@ -123,6 +123,10 @@ pub fn run(job: &SimulateJob) -> Result<SimulateSummary, JobError> {
     let table = match &job.out {
         None => None,
         Some(path) => {
+            // The table is one file, renamed into place whole (never half written) and
+            // carrying the invocation id; an interrupted earlier run's temporary files of it
+            // go, nothing else in that folder.
+            crate::outputs::remove_stale_temps_of_file(path)?;
             let cols = vec![
                 Column::f64("t", "1 (t = ω0·τ)", tr.t.clone()).describe("dimensionless time"),
                 Column::f64("theta", "rad", tr.theta.clone())

@@ -9,27 +9,54 @@ use pendulum_rig::RigError;
 use crate::inputs::Inputs;
 use crate::JobError;
 
+/// Writes the twin's campaign into `out_dir` as one unit: the completion marker goes first,
+/// this program's stale temporary files of the campaign's files go (nothing else in the
+/// folder), every file is written under a temporary name unique to this process and renamed
+/// into place, and the marker naming them is written last ([`crate::outputs::mark_complete`]).
 pub fn run(case_path: &Path, out_dir: &Path) -> Result<TwinSummary, JobError> {
     let case = TwinCase::load(case_path)?;
     check_ids(&case, case_path)?;
-    check_outputs(&case, case_path, out_dir)?;
-    Ok(synthesize(&case, out_dir)?)
+    let names = output_names(&case);
+    check_outputs(&names, case_path, out_dir)?;
+    std::fs::create_dir_all(out_dir).map_err(|source| JobError::Io {
+        path: out_dir.to_path_buf(),
+        source,
+    })?;
+    crate::outputs::remove_marker(out_dir)?;
+    crate::outputs::remove_stale_temps_of(out_dir, &names)?;
+    let summary = synthesize(&case, out_dir)?;
+    let files: Vec<_> = names
+        .iter()
+        .filter(|n| *n != crate::outputs::COMPLETE_MARKER)
+        .map(|n| out_dir.join(n))
+        .collect();
+    crate::outputs::mark_complete(out_dir, "pendulum synth", &files)?;
+    Ok(summary)
 }
 
-/// The files the twin writes into `out_dir` (and its temporaries for the last two): none may be
-/// the case file itself (`pendulum synth OUT/campaign.toml OUT`).
-fn check_outputs(case: &TwinCase, case_path: &Path, out_dir: &Path) -> Result<(), JobError> {
-    let mut inputs = Inputs::new();
-    inputs.add("the case file", case_path);
-    let mut names: Vec<String> = ["campaign.toml", "campaign.tmp", "truth.json", "truth.tmp"]
-        .map(String::from)
-        .into();
+/// The files the twin writes into its folder (the marker included).
+fn output_names(case: &TwinCase) -> Vec<String> {
+    let mut names: Vec<String> = [
+        "campaign.toml",
+        "truth.json",
+        crate::outputs::COMPLETE_MARKER,
+    ]
+    .map(String::from)
+    .into();
     for run in &case.runs {
         names.push(match run.format {
             TwinFormat::Serial => format!("{}.csv", run.id),
             TwinFormat::Sd => format!("{}.bin", run.id),
         });
     }
+    names
+}
+
+/// None of the files the twin writes may be the case file itself (`pendulum synth
+/// OUT/campaign.toml OUT`).
+fn check_outputs(names: &[String], case_path: &Path, out_dir: &Path) -> Result<(), JobError> {
+    let mut inputs = Inputs::new();
+    inputs.add("the case file", case_path);
     for name in names {
         inputs.check_output("the output", &out_dir.join(name))?;
     }

@@ -2,7 +2,7 @@
 
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
-use std::sync::OnceLock;
+use std::sync::{Mutex, OnceLock};
 
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -121,6 +121,14 @@ pub fn save_atomic(
         let _ = std::fs::remove_file(&tmp);
         return Err(draw_err(what));
     }
+    if let Err(source) = stamp_text(&tmp) {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(PlotError::Io {
+            path: path.to_path_buf(),
+            what: format!("adding the text chunks to {}", tmp.display()),
+            source,
+        });
+    }
     std::fs::rename(&tmp, path).map_err(|source| {
         let _ = std::fs::remove_file(&tmp);
         PlotError::Io {
@@ -129,6 +137,110 @@ pub fn save_atomic(
             source,
         }
     })
+}
+
+/// The `tEXt` entries every PNG of this process carries ([`set_png_text`]).
+static PNG_TEXT: Mutex<Vec<(String, String)>> = Mutex::new(Vec::new());
+
+/// From now on every PNG this process writes carries a `tEXt` chunk `key` = `value` (replacing
+/// an earlier value of `key`): the program stamps its plots with its invocation id, as its
+/// tables, so that the files of one result folder can be told from an earlier run's. A key
+/// PNG does not allow (1–79 printable Latin-1 characters without leading, trailing or double
+/// spaces; here printable ASCII) or a value holding NUL is refused.
+pub fn set_png_text(key: &str, value: &str) -> Result<(), String> {
+    let key_ok = (1..=79).contains(&key.len())
+        && key.bytes().all(|b| (0x20..0x7f).contains(&b))
+        && !key.starts_with(' ')
+        && !key.ends_with(' ')
+        && !key.contains("  ");
+    if !key_ok {
+        return Err(format!("{key:?} is not a PNG text keyword"));
+    }
+    if value.contains('\0') || !value.is_ascii() {
+        return Err(format!("{value:?} is not PNG text (ASCII without NUL)"));
+    }
+    let mut t = PNG_TEXT.lock().unwrap_or_else(|e| e.into_inner());
+    match t.iter_mut().find(|(k, _)| k == key) {
+        Some(e) => e.1 = value.to_string(),
+        None => t.push((key.to_string(), value.to_string())),
+    }
+    Ok(())
+}
+
+/// CRC-32 of PNG chunks (ISO 3309, reflected 0xEDB88320).
+fn crc32(parts: &[&[u8]]) -> u32 {
+    let mut c = !0u32;
+    for part in parts {
+        for &b in *part {
+            c ^= u32::from(b);
+            for _ in 0..8 {
+                c = if c & 1 != 0 {
+                    (c >> 1) ^ 0xEDB8_8320
+                } else {
+                    c >> 1
+                };
+            }
+        }
+    }
+    !c
+}
+
+/// Inserts the [`set_png_text`] entries as `tEXt` chunks right after the IHDR chunk of the PNG
+/// file at `path` (a no-op when there are none).
+fn stamp_text(path: &Path) -> std::io::Result<()> {
+    let entries = PNG_TEXT.lock().unwrap_or_else(|e| e.into_inner()).clone();
+    if entries.is_empty() {
+        return Ok(());
+    }
+    let png = std::fs::read(path)?;
+    // Signature (8) and the IHDR chunk (length 4, type 4, 13 data bytes, CRC 4).
+    const IHDR_END: usize = 8 + 4 + 4 + 13 + 4;
+    if png.len() < IHDR_END || &png[12..16] != b"IHDR" {
+        return Err(std::io::Error::other("the encoder's output is not a PNG"));
+    }
+    let mut out = Vec::with_capacity(png.len() + 64 * entries.len());
+    out.extend_from_slice(&png[..IHDR_END]);
+    for (k, v) in &entries {
+        let mut data = Vec::with_capacity(k.len() + 1 + v.len());
+        data.extend_from_slice(k.as_bytes());
+        data.push(0);
+        data.extend_from_slice(v.as_bytes());
+        let len = u32::try_from(data.len()).map_err(std::io::Error::other)?;
+        out.extend_from_slice(&len.to_be_bytes());
+        out.extend_from_slice(b"tEXt");
+        out.extend_from_slice(&data);
+        out.extend_from_slice(&crc32(&[b"tEXt", &data]).to_be_bytes());
+    }
+    out.extend_from_slice(&png[IHDR_END..]);
+    std::fs::write(path, out)
+}
+
+/// The `tEXt` entries of a PNG file's bytes, in file order (chunks whose CRC does not match
+/// are left out).
+pub fn png_text_of(png: &[u8]) -> Vec<(String, String)> {
+    let mut out = Vec::new();
+    let mut i = 8;
+    while i + 12 <= png.len() {
+        let len = u32::from_be_bytes([png[i], png[i + 1], png[i + 2], png[i + 3]]) as usize;
+        let Some(end) = (i + 8).checked_add(len).filter(|&e| e + 4 <= png.len()) else {
+            break;
+        };
+        let (kind, data) = (&png[i + 4..i + 8], &png[i + 8..end]);
+        let crc = u32::from_be_bytes([png[end], png[end + 1], png[end + 2], png[end + 3]]);
+        if kind == b"tEXt" && crc == crc32(&[kind, data]) {
+            if let Some(z) = data.iter().position(|&b| b == 0) {
+                out.push((
+                    String::from_utf8_lossy(&data[..z]).into_owned(),
+                    String::from_utf8_lossy(&data[z + 1..]).into_owned(),
+                ));
+            }
+        }
+        if kind == b"IEND" {
+            break;
+        }
+        i = end + 4;
+    }
+    out
 }
 
 /// Draw `text` centred at pixel (x, y) of `area`.

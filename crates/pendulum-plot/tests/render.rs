@@ -543,3 +543,43 @@ fn concurrent_saves_do_not_clash() {
     assert_eq!(png_size(&dir.path().join("same.png")), (400, 300));
     no_temp_files_left(dir.path());
 }
+
+/// Issue 13, item 6: every PNG carries the text set for the process (the program's invocation
+/// id), in a `tEXt` chunk right after IHDR that a PNG reader accepts (valid CRC); the image is
+/// unchanged otherwise; a key PNG does not allow is refused.
+#[test]
+fn issue_13_pngs_carry_the_process_text() {
+    let dir = tempfile::tempdir().unwrap();
+    let fig = Figure {
+        title: "t".into(),
+        panels: vec![panel(
+            "p",
+            vec![line("a", vec![0.0, 1.0], vec![0.0, 1.0], SeriesStyle::Line)],
+        )],
+        width: 320,
+        height: 240,
+    };
+    pendulum_plot::set_png_text("invocation_id", "1700000000.000000001-42").unwrap();
+    pendulum_plot::set_png_text("invocation_id", "1700000000.000000002-42").unwrap();
+    let path = dir.path().join("stamped.png");
+    fig.save_png(&path).unwrap();
+    let bytes = std::fs::read(&path).unwrap();
+    assert_eq!(&bytes[33 + 4..33 + 8], b"tEXt", "the chunk follows IHDR");
+    let text = pendulum_plot::png_text_of(&bytes);
+    assert_eq!(
+        text,
+        [(
+            "invocation_id".to_string(),
+            "1700000000.000000002-42".to_string()
+        )]
+    );
+    assert_eq!(png_size(&path), (320, 240));
+    no_temp_files_left(dir.path());
+    // A corrupted chunk is not read back as text.
+    let mut bad = bytes.clone();
+    bad[33 + 9] ^= 1;
+    assert!(pendulum_plot::png_text_of(&bad).is_empty());
+    assert!(pendulum_plot::set_png_text("", "x").is_err());
+    assert!(pendulum_plot::set_png_text(" lead", "x").is_err());
+    assert!(pendulum_plot::set_png_text("k", "a\0b").is_err());
+}

@@ -153,7 +153,31 @@ impl Campaign {
         } else {
             p.to_path_buf()
         };
-        let text = std::fs::read_to_string(&toml_path).map_err(|e| RigError::io(&toml_path, e))?;
+        // Read at most one byte past the limit: a hostile campaign.toml of gigabytes is refused
+        // without being held in memory (a 19 MB `name` used to take 170 MB).
+        let file = std::fs::File::open(&toml_path).map_err(|e| RigError::io(&toml_path, e))?;
+        let mut bytes = Vec::new();
+        std::io::Read::read_to_end(
+            &mut std::io::Read::take(file, MAX_CAMPAIGN_BYTES + 1),
+            &mut bytes,
+        )
+        .map_err(|e| RigError::io(&toml_path, e))?;
+        if bytes.len() as u64 > MAX_CAMPAIGN_BYTES {
+            return Err(RigError::TooLarge {
+                path: toml_path,
+                at: format!("more than {MAX_CAMPAIGN_BYTES} bytes"),
+                what: "a campaign description is a few KB (about 150 bytes a run): not read".into(),
+            });
+        }
+        let text = String::from_utf8(bytes).map_err(|e| {
+            RigError::io(
+                &toml_path,
+                std::io::Error::new(
+                    std::io::ErrorKind::InvalidData,
+                    format!("not UTF-8 text (byte {})", e.utf8_error().valid_up_to()),
+                ),
+            )
+        })?;
         Self::parse(&text, &toml_path)
     }
 
@@ -165,6 +189,7 @@ impl Campaign {
             Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
             _ => PathBuf::from("."),
         };
+        check_line_lengths(text, path)?;
         let mut table: toml::Table = toml::from_str(text).map_err(|e| {
             let (line, column) = e.span().map(|s| line_col(text, s.start)).unwrap_or((1, 1));
             RigError::CampaignSyntax {
@@ -497,6 +522,33 @@ fn positive(v: &Value) -> Option<f64> {
 }
 
 /// 1-based line and column (in characters) of a byte offset.
+/// The largest `campaign.toml` read: 1 MiB is some 7,000 runs.
+pub const MAX_CAMPAIGN_BYTES: u64 = 1024 * 1024;
+
+/// The longest line of a `campaign.toml`: keys, ids, notes and file names are short; a longer
+/// line is damage or a hostile file (the TOML parser would copy it more than once).
+pub const MAX_CAMPAIGN_LINE_BYTES: usize = 64 * 1024;
+
+/// Refuses a line longer than [`MAX_CAMPAIGN_LINE_BYTES`], naming its line and byte offset.
+fn check_line_lengths(text: &str, path: &Path) -> Result<(), RigError> {
+    let mut start = 0usize;
+    for (i, line) in text.split('\n').enumerate() {
+        if line.len() > MAX_CAMPAIGN_LINE_BYTES {
+            return Err(RigError::TooLarge {
+                path: path.to_path_buf(),
+                at: format!("line {}, byte {start}", i + 1),
+                what: format!(
+                    "a line of {} bytes, longer than the {MAX_CAMPAIGN_LINE_BYTES} a campaign \
+                     line may hold",
+                    line.len()
+                ),
+            });
+        }
+        start += line.len() + 1;
+    }
+    Ok(())
+}
+
 fn line_col(text: &str, offset: usize) -> (usize, usize) {
     let mut off = offset.min(text.len());
     while !text.is_char_boundary(off) {

@@ -913,6 +913,226 @@ impl<T: Record> Lookahead<T> {
     }
 }
 
+/// How many segments (runs of records between two jumps of the clock) a reader remembers for
+/// [`TimelinePlan`]. A capture with more jumps than this is so broken that no majority can be
+/// told: then no plan is made (the read-ahead window's verdicts stand).
+const MAX_SEGMENTS: usize = 1024;
+
+/// How many consecutive segments one block off the timeline may span (a stale block that is
+/// itself broken by a jump).
+const MAX_BLOCK_SEGMENTS: usize = 8;
+
+/// How many times a capture is read at most: the first reading, and again while a reading
+/// finds blocks off the timeline (each reading drops what the ones before found; a block
+/// inside a block needs a third).
+pub const MAX_READINGS: usize = 3;
+
+/// A run of kept records whose steps are all ordinary, as a reader's first pass saw it.
+#[derive(Debug, Clone, Copy)]
+struct Segment {
+    first_at: Location,
+    last_at: Location,
+    first_raw: u32,
+    last_raw: u32,
+    records: u64,
+}
+
+/// The segments of a reader's pass: where the clock jumped (ahead beyond a lone step, back,
+/// or restarted) between kept records. Bounded by [`MAX_SEGMENTS`].
+#[derive(Debug, Default)]
+pub(crate) struct SegmentLog {
+    segs: Vec<Segment>,
+    overflow: bool,
+}
+
+impl SegmentLog {
+    /// A record was kept; `jumped`: its step from the last kept record was not ordinary (a
+    /// believed gap or a new segment).
+    pub(crate) fn kept(&mut self, at: Location, raw: u32, jumped: bool) {
+        if self.overflow {
+            return;
+        }
+        if !jumped {
+            if let Some(s) = self.segs.last_mut() {
+                s.last_at = at;
+                s.last_raw = raw;
+                s.records += 1;
+                return;
+            }
+        }
+        if self.segs.len() == MAX_SEGMENTS {
+            self.overflow = true;
+            self.segs = Vec::new();
+        } else {
+            self.segs.push(Segment {
+                first_at: at,
+                last_at: at,
+                first_raw: raw,
+                last_raw: raw,
+                records: 1,
+            });
+        }
+    }
+
+    /// The blocks this pass kept that the majority of the evidence says are off the timeline.
+    ///
+    /// A block (one or a few consecutive segments) is off the timeline when the segment after
+    /// it continues the segment before it (the step between them is in order and no longer
+    /// than the block could have covered: the block was inserted, or replaced as many records),
+    /// the block's stamps do not lie between the two (records after real gaps do), and the two
+    /// together hold more records than the block. The clock cannot leave its
+    /// timeline and come back to it, so the side that does not fit is the damage: a stale or
+    /// future-stamped block, or a chunk repeated out of place, whatever its length. A first or
+    /// last segment has only one side: nothing says which of the two is right, so both stay
+    /// (a new segment). Of several candidates the one with the smallest share of the records
+    /// around it is decided first (a long stale block must not make a real gap before it look
+    /// like the excursion).
+    pub(crate) fn plan(&self, rule: OrderRule) -> Option<TimelinePlan> {
+        if self.overflow {
+            return None;
+        }
+        let mut segs = self.segs.clone();
+        let mut blocks = Vec::new();
+        loop {
+            // (ratio, first index of the block, index of the segment resuming the timeline)
+            let mut best: Option<(f64, usize, usize)> = None;
+            for i in 1..segs.len() {
+                let before = segs[i - 1];
+                let mut inside = 0u64;
+                for j in (i + 1)..segs.len().min(i + 1 + MAX_BLOCK_SEGMENTS) {
+                    inside += segs[j - 1].records;
+                    let after = segs[j];
+                    let step = signed_step(before.last_raw, after.first_raw);
+                    let reach = rule.max_lone_step_us.saturating_add(
+                        2i64.saturating_mul(rule.period_us.max(1))
+                            .saturating_mul(i64::try_from(inside).unwrap_or(i64::MAX)),
+                    );
+                    let around = before.records + after.records;
+                    // Every segment of the block lies off the line from `before` to `after`
+                    // (real data after real gaps lies between them in time).
+                    let off = segs[i..j].iter().all(|s| {
+                        signed_step(before.last_raw, s.first_raw) < rule.min_step_us
+                            || signed_step(s.last_raw, after.first_raw) < rule.min_step_us
+                    });
+                    if off && step >= rule.min_step_us && step <= reach && inside < around {
+                        let ratio = inside as f64 / around as f64;
+                        if best.is_none_or(|b| ratio < b.0) {
+                            best = Some((ratio, i, j));
+                        }
+                        break;
+                    }
+                }
+            }
+            let Some((_, i, j)) = best else { break };
+            let (before, after) = (segs[i - 1], segs[j]);
+            blocks.push(OffTimelineBlock {
+                from: segs[i].first_at,
+                to: segs[j - 1].last_at,
+                records: segs[i..j].iter().map(|s| s.records).sum(),
+                shift_us: signed_step(before.last_raw, segs[i].first_raw),
+                resumes_at: after.first_at,
+                around: before.records + after.records,
+            });
+            let merged = Segment {
+                first_at: before.first_at,
+                first_raw: before.first_raw,
+                last_at: after.last_at,
+                last_raw: after.last_raw,
+                records: before.records + after.records,
+            };
+            segs.splice(i - 1..=j, [merged]);
+        }
+        if blocks.is_empty() {
+            return None;
+        }
+        blocks.sort_by_key(|b| loc_key(b.from));
+        Some(TimelinePlan { blocks })
+    }
+}
+
+/// A block of records a first pass kept that is off the timeline (see [`TimelinePlan`]).
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+pub struct OffTimelineBlock {
+    /// The block's first and last records.
+    pub from: Location,
+    pub to: Location,
+    /// Records the first pass kept in it.
+    pub records: u64,
+    /// How far its first stamp is from the timeline before it, µs.
+    pub shift_us: i64,
+    /// The first record after it, where the timeline resumes.
+    pub resumes_at: Location,
+    /// Records of the timeline on either side of it that continue across it.
+    pub around: u64,
+}
+
+/// What a capture's second reading drops: the blocks a first reading kept although the
+/// timeline before and after them continues across them (stale or future-stamped blocks and
+/// chunks repeated out of place longer than the [`TIMELINE_WINDOW`] read ahead).
+///
+/// A reader decides a jump of the clock on the records it reads ahead; a block longer than
+/// that cannot be told from a real jump until it ends. So a reader records where its clock
+/// jumped, and at the end of the capture says which blocks the majority of the evidence
+/// rejects ([`crate::SdReader::timeline_plan`]); the capture is then read again with the plan
+/// ([`crate::SdReader::set_timeline_plan`]), and those blocks are dropped as off the timeline
+/// (in `off_timeline` and the skips, with a warning each). Captures without such a block are
+/// read once.
+#[derive(Debug, Clone, Default, PartialEq, Eq, Serialize)]
+pub struct TimelinePlan {
+    /// Sorted by position, not overlapping.
+    pub blocks: Vec<OffTimelineBlock>,
+}
+
+impl TimelinePlan {
+    pub fn is_empty(&self) -> bool {
+        self.blocks.is_empty()
+    }
+
+    /// Adds the blocks of a later reading (made with this plan, so they do not overlap).
+    pub fn merge(&mut self, other: TimelinePlan) {
+        self.blocks.extend(other.blocks);
+        self.blocks.sort_by_key(|b| loc_key(b.from));
+    }
+
+    /// The block that holds the record at `at`.
+    pub(crate) fn covering(&self, at: Location) -> Option<&OffTimelineBlock> {
+        let k = loc_key(at);
+        let i = self.blocks.partition_point(|b| loc_key(b.from) <= k);
+        let b = self.blocks.get(i.checked_sub(1)?)?;
+        (loc_key(b.to) >= k).then_some(b)
+    }
+
+    /// The warning a reader gives for each block it drops.
+    pub(crate) fn warnings(&self) -> impl Iterator<Item = String> + '_ {
+        self.blocks.iter().map(|b| {
+            format!(
+                "{}–{}: {} records stamped {:+.6} s off the timeline dropped: the {} records \
+                 before and after them continue across them (the timeline resumes at {})",
+                b.from,
+                b.to,
+                b.records,
+                b.shift_us as f64 * 1e-6,
+                b.around,
+                b.resumes_at
+            )
+        })
+    }
+
+    /// The skip reason of a record in `b`.
+    pub(crate) fn reason(b: &OffTimelineBlock, t_raw: u32) -> String {
+        format!(
+            "stamped {:+.6} s off the timeline in a block of {} records ({}–{}), which resumes at \
+             {}: the {} records around it agree (t_us={t_raw})",
+            b.shift_us as f64 * 1e-6,
+            b.records,
+            b.from,
+            b.to,
+            b.resumes_at,
+            b.around
+        )
+    }
+}
+
 /// Outlier rejection with a few records of lookahead, on the raw clock.
 ///
 /// A damaged record that still parses (merged serial lines, a CRC collision) nearly always has a

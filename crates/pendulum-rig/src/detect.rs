@@ -5,7 +5,7 @@ use std::io::{BufRead, BufReader};
 use std::path::Path;
 
 use crate::campaign::RunSpec;
-use crate::capture::{Header, IngestStats, Location, ReadOptions, Sample};
+use crate::capture::{Header, IngestStats, Location, ReadOptions, Sample, TimelinePlan};
 use crate::error::RigError;
 use crate::sd::{SdReader, SYNC};
 use crate::serial::{SerialReader, COLUMN_LINE};
@@ -99,6 +99,40 @@ impl CaptureReader {
             CaptureReader::Sd(r) => r.next_sample(),
             CaptureReader::Timeseries(r) => r.next_sample(),
         }
+    }
+
+    /// See [`SdReader::set_timeline_plan`] (a generic time series has no board clock to
+    /// judge: ignored).
+    pub fn set_timeline_plan(&mut self, plan: TimelinePlan) {
+        match self {
+            CaptureReader::Serial(r) => r.set_timeline_plan(plan),
+            CaptureReader::Sd(r) => r.set_timeline_plan(plan),
+            CaptureReader::Timeseries(_) => {}
+        }
+    }
+
+    /// See [`SdReader::timeline_plan`]: after the last sample, the blocks to drop on a second
+    /// reading, if any.
+    pub fn timeline_plan(&self) -> Option<TimelinePlan> {
+        match self {
+            CaptureReader::Serial(r) => r.timeline_plan(),
+            CaptureReader::Sd(r) => r.timeline_plan(),
+            CaptureReader::Timeseries(_) => None,
+        }
+    }
+
+    /// Opens a run's capture ([`CaptureReader::open_run`]) with the plan of an earlier reading
+    /// (none on the first).
+    pub fn open_run_planned(
+        spec: &RunSpec,
+        opts: ReadOptions,
+        plan: Option<&TimelinePlan>,
+    ) -> Result<Self, RigError> {
+        let mut r = Self::open_run(spec, opts)?;
+        if let Some(p) = plan {
+            r.set_timeline_plan(p.clone());
+        }
+        Ok(r)
     }
 
     pub fn header(&self) -> &Header {

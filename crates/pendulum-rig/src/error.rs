@@ -50,6 +50,16 @@ pub enum RigError {
         message: String,
     },
 
+    /// An input longer than such a file can sensibly be (a campaign description of megabytes,
+    /// a line of one): refused before it is read into memory. `at` says where (`line 3,
+    /// byte 120`, or the size).
+    #[error("{}: {at}: {what}", .path.display())]
+    TooLarge {
+        path: PathBuf,
+        at: String,
+        what: String,
+    },
+
     /// A campaign key is missing or has the wrong type or value.
     #[error("{}: {}key `{key}`: expected {expected}", .path.display(), run_label(.run))]
     CampaignKey {

@@ -16,7 +16,8 @@ pub mod serial;
 
 pub use campaign::{Campaign, Role, RunSpec};
 pub use capture::{
-    AccelSample, EncoderSample, Gap, Header, IngestStats, Location, ReadOptions, Sample, Skip,
+    AccelSample, EncoderSample, Gap, Header, IngestStats, Location, OffTimelineBlock, ReadOptions,
+    Sample, Skip, TimelinePlan,
 };
 pub use detect::CaptureReader;
 pub use error::RigError;

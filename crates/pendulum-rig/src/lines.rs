@@ -5,9 +5,12 @@
 use std::io::{self, BufRead};
 
 /// One line as read: its content is in the caller's buffer (without `\n` / `\r\n`).
+#[derive(Debug, Clone, Copy)]
 pub(crate) struct LineInfo {
     /// 1-based line number.
     pub number: u64,
+    /// 0-based byte offset of the line's first byte in the file.
+    pub start: u64,
     /// Bytes in the file, line end included.
     pub bytes: u64,
     /// More than `max` bytes: the content was cut.
@@ -17,11 +20,12 @@ pub(crate) struct LineInfo {
 }
 
 /// Reads the next line of `reader` into `line` (cleared first), keeping at most `max` bytes;
-/// `line_no` counts lines. `None` at the end of input.
+/// `line_no` counts lines, `pos` bytes. `None` at the end of input.
 pub(crate) fn read_bounded_line<R: BufRead>(
     reader: &mut R,
     line: &mut Vec<u8>,
     line_no: &mut u64,
+    pos: &mut u64,
     max: usize,
 ) -> io::Result<Option<LineInfo>> {
     line.clear();
@@ -62,8 +66,11 @@ pub(crate) fn read_bounded_line<R: BufRead>(
         line.pop();
     }
     *line_no += 1;
+    let start = *pos;
+    *pos += bytes;
     Ok(Some(LineInfo {
         number: *line_no,
+        start,
         bytes,
         overlong,
         terminated,

@@ -10,8 +10,8 @@ use std::path::{Path, PathBuf};
 use crate::capture::{
     accel_si, accel_step_plausible, check_rate, encoder_step_plausible, signed_step, theta_rad,
     value_glitch, AccelSample, Clock, Counter, EncoderSample, GapTracker, Header, IngestStats,
-    Location, Lookahead, OrderRule, ReadOptions, Recent, Record, Sample, Timeline, CONFIRM_RECORDS,
-    RATE_PROBE_RECORDS, TIMELINE_WINDOW,
+    Location, Lookahead, OrderRule, ReadOptions, Recent, Record, Sample, SegmentLog, Timeline,
+    TimelinePlan, CONFIRM_RECORDS, RATE_PROBE_RECORDS, TIMELINE_WINDOW,
 };
 use crate::crc8::crc8;
 use crate::error::RigError;
@@ -133,6 +133,10 @@ pub struct SdReader<R: Read> {
     probed: bool,
     encoder_period_us: f64,
     recent: Recent,
+    /// Where the clock jumped between kept frames, for [`SdReader::timeline_plan`].
+    segments: SegmentLog,
+    /// Blocks an earlier reading found off the timeline: dropped as they are read.
+    plan: TimelinePlan,
     /// The last kept frame of each stream: raw time and value, for plausibility.
     last_enc_raw: Option<(u32, i16)>,
     last_acc_raw: Option<(u32, [i16; 3])>,
@@ -171,6 +175,8 @@ impl<R: Read> SdReader<R> {
             probed: false,
             encoder_period_us: 1000.0,
             recent: Recent::default(),
+            segments: SegmentLog::default(),
+            plan: TimelinePlan::default(),
             last_enc_raw: None,
             last_acc_raw: None,
             clock: Clock::default(),
@@ -250,6 +256,22 @@ impl<R: Read> SdReader<R> {
 
     pub fn stats(&self) -> &IngestStats {
         &self.stats
+    }
+
+    /// Drops the blocks of `plan` (from an earlier reading of the same capture) as they are
+    /// read, each with a warning. Call before the first [`SdReader::next_sample`].
+    pub fn set_timeline_plan(&mut self, plan: TimelinePlan) {
+        for w in plan.warnings() {
+            self.stats.warn(w);
+        }
+        self.plan = plan;
+    }
+
+    /// After the last sample: the blocks this reading kept that the majority of the evidence
+    /// puts off the timeline (see [`TimelinePlan`]), or `None` when there are none. Read the
+    /// capture again with [`SdReader::set_timeline_plan`] to drop them.
+    pub fn timeline_plan(&self) -> Option<TimelinePlan> {
+        self.segments.plan(self.order)
     }
 
     fn not_a_capture(&self, at: u64, reason: &str) -> RigError {
@@ -456,6 +478,18 @@ impl<R: Read> SdReader<R> {
                         f.len,
                     );
                 }
+                Some(f) if self.plan.covering(Location::Byte(f.offset)).is_some() => {
+                    let at = Location::Byte(f.offset);
+                    let reason = self
+                        .plan
+                        .covering(at)
+                        .map(|b| TimelinePlan::reason(b, f.t_us))
+                        .unwrap_or_default();
+                    self.stats.off_timeline += 1;
+                    self.recent.push_dropped(&f);
+                    self.stats
+                        .skip(at, format!("frame with valid CRC dropped: {reason}"), f.len);
+                }
                 other => return Ok(other),
             }
         }
@@ -632,6 +666,12 @@ impl<R: Read> SdReader<R> {
                     .skip(at, format!("frame with valid CRC dropped: {why}"), cand.len);
                 continue;
             }
+            let jumped = segment.is_some()
+                || self.clock.last_raw().is_some_and(|p| {
+                    let s = signed_step(p, cand.t_us);
+                    s < self.order.min_step_us || s > self.order.max_lone_step_us
+                });
+            self.segments.kept(at, cand.t_us, jumped);
             match segment {
                 Some(reset) => {
                     self.clock.reanchor(cand.t_us, t_us);

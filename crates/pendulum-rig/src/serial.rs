@@ -10,8 +10,8 @@ use std::path::{Path, PathBuf};
 use crate::capture::{
     accel_si, accel_step_plausible, check_rate, encoder_step_plausible, signed_step, snippet,
     theta_rad, value_glitch, AccelSample, Clock, Counter, EncoderSample, GapTracker, Header,
-    IngestStats, Location, Lookahead, OrderRule, ReadOptions, Recent, Record, Sample, Timeline,
-    CONFIRM_RECORDS, RATE_PROBE_RECORDS, TIMELINE_WINDOW,
+    IngestStats, Location, Lookahead, OrderRule, ReadOptions, Recent, Record, Sample, SegmentLog,
+    Timeline, TimelinePlan, CONFIRM_RECORDS, RATE_PROBE_RECORDS, TIMELINE_WINDOW,
 };
 use crate::error::RigError;
 
@@ -20,6 +20,11 @@ pub const COLUMN_LINE: &str = "t_us,enc,ax,ay,az";
 
 /// Longer lines are garbage: a real sample line is at most ~40 bytes.
 const MAX_LINE_BYTES: usize = 1024;
+
+/// A header (the `#` lines before the column line) longer than this is refused: the firmware's
+/// is about 150 bytes; 64 KiB leaves room for any notes and keeps a damaged or hostile file
+/// (19 MB of `#` lines used to be read into memory, 94 MB) from growing memory.
+pub const MAX_HEADER_BYTES: u64 = 64 * 1024;
 
 /// A syntactically valid data line, not yet accepted.
 struct Row {
@@ -56,12 +61,18 @@ pub struct SerialReader<R: BufRead> {
     lsb_per_g: f64,
     order: OrderRule,
     line_no: u64,
+    /// Bytes read so far (where the next line starts).
+    byte_pos: u64,
     line: Vec<u8>,
     lookahead: Lookahead<Row>,
     /// The rate was checked against the first records ([`SerialReader::probe_rate`]).
     probed: bool,
     period_us: f64,
     recent: Recent,
+    /// Where the clock jumped between kept lines, for [`SerialReader::timeline_plan`].
+    segments: SegmentLog,
+    /// Blocks an earlier reading found off the timeline: dropped as they are read.
+    plan: TimelinePlan,
     /// The last kept line's raw time and values, for the plausibility of the next.
     last_row: Option<(u32, i16, [i16; 3])>,
     pending_accel: Option<AccelSample>,
@@ -88,11 +99,14 @@ impl<R: BufRead> SerialReader<R> {
                 max_lone_step_us: 15_000,
             },
             line_no: 0,
+            byte_pos: 0,
             line: Vec::with_capacity(128),
             lookahead: Lookahead::default(),
             probed: false,
             period_us: 5000.0,
             recent: Recent::default(),
+            segments: SegmentLog::default(),
+            plan: TimelinePlan::default(),
             last_row: None,
             pending_accel: None,
             clock: Clock::default(),
@@ -196,6 +210,22 @@ impl<R: BufRead> SerialReader<R> {
         &self.stats
     }
 
+    /// Drops the blocks of `plan` (from an earlier reading of the same capture) as they are
+    /// read, each with a warning. Call before the first [`SerialReader::next_sample`].
+    pub fn set_timeline_plan(&mut self, plan: TimelinePlan) {
+        for w in plan.warnings() {
+            self.stats.warn(w);
+        }
+        self.plan = plan;
+    }
+
+    /// After the last sample: the blocks this reading kept that the majority of the evidence
+    /// puts off the timeline (see [`TimelinePlan`]), or `None` when there are none. Read the
+    /// capture again with [`SerialReader::set_timeline_plan`] to drop them.
+    pub fn timeline_plan(&self) -> Option<TimelinePlan> {
+        self.segments.plan(self.order)
+    }
+
     fn not_a_capture(&self, line: u64, reason: String) -> RigError {
         RigError::NotACapture {
             path: self.path.clone(),
@@ -207,6 +237,16 @@ impl<R: BufRead> SerialReader<R> {
     fn read_header(&mut self) -> Result<(), RigError> {
         let mut seen_header = false;
         loop {
+            if self.byte_pos > MAX_HEADER_BYTES {
+                return Err(self.not_a_capture(
+                    self.line_no,
+                    format!(
+                        "the header runs past {MAX_HEADER_BYTES} bytes (line {}, byte {}) without \
+                         the column line `{COLUMN_LINE}`: a capture's header is a few hundred bytes",
+                        self.line_no, self.byte_pos
+                    ),
+                ));
+            }
             let Some(info) = self.read_line()? else {
                 let reason = if seen_header {
                     format!("the file ends before the column line `{COLUMN_LINE}`")
@@ -218,7 +258,10 @@ impl<R: BufRead> SerialReader<R> {
             if info.overlong {
                 return Err(self.not_a_capture(
                     info.number,
-                    format!("header line longer than {MAX_LINE_BYTES} bytes"),
+                    format!(
+                        "header line {} (from byte {}) is {} bytes, longer than {MAX_LINE_BYTES}",
+                        info.number, info.start, info.bytes
+                    ),
                 ));
             }
             let mut content: &[u8] = &self.line;
@@ -268,6 +311,7 @@ impl<R: BufRead> SerialReader<R> {
             &mut self.reader,
             &mut self.line,
             &mut self.line_no,
+            &mut self.byte_pos,
             MAX_LINE_BYTES,
         )
         .map_err(|e| RigError::io(&self.path, e))
@@ -282,7 +326,10 @@ impl<R: BufRead> SerialReader<R> {
             if info.overlong {
                 self.stats.skip(
                     Location::Line(info.number),
-                    format!("line longer than {MAX_LINE_BYTES} bytes (garbage)"),
+                    format!(
+                        "line of {} bytes from byte {}, longer than {MAX_LINE_BYTES} (garbage)",
+                        info.bytes, info.start
+                    ),
                     info.bytes,
                 );
                 continue;
@@ -304,13 +351,22 @@ impl<R: BufRead> SerialReader<R> {
             }
             match parse_row(&self.line) {
                 Ok((t_us, enc, accel)) => {
-                    return Ok(Some(Row {
+                    let row = Row {
                         line: info.number,
                         bytes: info.bytes,
                         t_us,
                         enc,
                         accel,
-                    }))
+                    };
+                    let at = Location::Line(info.number);
+                    if let Some(b) = self.plan.covering(at) {
+                        let reason = format!("{}: dropped", TimelinePlan::reason(b, t_us));
+                        self.stats.off_timeline += 1;
+                        self.recent.push_dropped(&row);
+                        self.stats.skip(at, reason, info.bytes);
+                        continue;
+                    }
+                    return Ok(Some(row));
                 }
                 Err(why) => {
                     let reason = format!("{why}: {}", snippet(&self.line));
@@ -387,6 +443,12 @@ impl<R: BufRead> SerialReader<R> {
                 self.stats.skip(at, format!("{why}: dropped"), cand.bytes);
                 continue;
             }
+            let jumped = segment.is_some()
+                || self.clock.last_raw().is_some_and(|p| {
+                    let s = signed_step(p, cand.t_us);
+                    s < self.order.min_step_us || s > self.order.max_lone_step_us
+                });
+            self.segments.kept(at, cand.t_us, jumped);
             match segment {
                 Some(reset) => {
                     self.clock.reanchor(cand.t_us, t_us);

@@ -17,6 +17,11 @@
 //! # accel_z_column = "az"; accel_x_column = "ax"; accel_y_column = "ay"; accel_unit = "m/s2" | "g"
 //! ```
 //!
+//! A column is named (`"t_s"`) or given by its 0-based index (`time_column = 0`, `angle_column
+//! = 1`, the first column is 0): when every column the run uses is given by index, the file
+//! needs no column-name line (a recording that starts with its first sample); a first line
+//! that is all numbers is then data. An index also works when the file has a column-name line.
+//!
 //! Optional keys: `time_unit` (`s`, `ms`, `us`; default `s`), `delimiter` (`","`, `"\t"`, `";"`,
 //! `" "` for runs of blanks; default: detected from the column line), `counts_per_rev` also with
 //! `rad`/`deg` (then the encoder-equivalent count is filled in). Rig keys (`m_kg`, `l_m`, …) are
@@ -149,24 +154,44 @@ impl Delimiter {
     }
 }
 
+/// A column of a time-series file: by its name in the column-name line, or by its 0-based
+/// index (then the file needs no column-name line when every column is given so).
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+pub enum ColumnRef {
+    Name(String),
+    Index(usize),
+}
+
+impl std::fmt::Display for ColumnRef {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            ColumnRef::Name(n) => f.write_str(n),
+            ColumnRef::Index(i) => write!(f, "#{i}"),
+        }
+    }
+}
+
+/// The largest column index a run may give (a file of more columns is no time series).
+pub const MAX_COLUMN_INDEX: i64 = 9999;
+
 /// A `format = "timeseries"` run's description of its file.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct TimeseriesSpec {
     /// The time column (in `time_unit`); `None` = times from `sample_hz`.
-    pub time_column: Option<String>,
+    pub time_column: Option<ColumnRef>,
     /// Seconds per unit of the time column (1, 1e-3 or 1e-6).
     pub time_scale_s: f64,
     /// The sample rate: the time base without a time column; with one, the nominal rate (for
     /// gap reports), and the time base when the stamps come in bursts (it overrides the rate
     /// measured over the bursts).
     pub sample_hz: Option<f64>,
-    pub angle_column: String,
+    pub angle_column: ColumnRef,
     pub angle_unit: AngleUnit,
     pub counts_per_rev: Option<f64>,
     /// The angle's value at the hanging position, in `angle_unit`.
     pub hanging_angle: f64,
     /// `[x, y, z]` accelerometer columns.
-    pub accel_columns: [Option<String>; 3],
+    pub accel_columns: [Option<ColumnRef>; 3],
     pub accel_unit: AccelUnit,
     /// `None` = detected from the column line.
     pub delimiter: Option<Delimiter>,
@@ -186,11 +211,19 @@ impl TimeseriesSpec {
             key: key.to_string(),
             expected: expected.to_string(),
         };
-        let string = |key: &str| -> Result<Option<String>, RigError> {
+        let column = |key: &str| -> Result<Option<ColumnRef>, RigError> {
             match keys.get(key) {
                 None => Ok(None),
-                Some(Value::String(s)) if !s.trim().is_empty() => Ok(Some(s.trim().to_string())),
-                Some(_) => Err(err(key, "a non-empty string (a column name)")),
+                Some(Value::String(s)) if !s.trim().is_empty() => {
+                    Ok(Some(ColumnRef::Name(s.trim().to_string())))
+                }
+                Some(Value::Integer(i)) if (0..=MAX_COLUMN_INDEX).contains(i) => {
+                    Ok(Some(ColumnRef::Index(*i as usize)))
+                }
+                Some(_) => Err(err(
+                    key,
+                    "a column name (a non-empty string) or a 0-based column index (0 to 9999)",
+                )),
             }
         };
         let number = |key: &str, positive: bool| -> Result<Option<f64>, RigError> {
@@ -221,7 +254,7 @@ impl TimeseriesSpec {
             }
             Ok(Some(v))
         };
-        let time_column = string("time_column")?;
+        let time_column = column("time_column")?;
         let sample_hz = number("sample_hz", true)?;
         if time_column.is_none() && sample_hz.is_none() {
             return Err(err(
@@ -240,7 +273,7 @@ impl TimeseriesSpec {
             Some(_) => return Err(err("time_unit", "\"s\", \"ms\" or \"us\"")),
         };
         let angle_column =
-            string("angle_column")?.ok_or_else(|| err("angle_column", "a column name"))?;
+            column("angle_column")?.ok_or_else(|| err("angle_column", "a column name or index"))?;
         let angle_unit = match keys.get("angle_unit") {
             Some(Value::String(s)) => match s.trim() {
                 "rad" => AngleUnit::Rad,
@@ -259,9 +292,9 @@ impl TimeseriesSpec {
         }
         let hanging_angle = number("hanging_angle", false)?.unwrap_or(0.0);
         let accel_columns = [
-            string("accel_x_column")?,
-            string("accel_y_column")?,
-            string("accel_z_column")?,
+            column("accel_x_column")?,
+            column("accel_y_column")?,
+            column("accel_z_column")?,
         ];
         let accel_unit = match keys.get("accel_unit") {
             None => AccelUnit::MS2,
@@ -325,6 +358,16 @@ impl TimeseriesSpec {
     fn has_accel(&self) -> bool {
         self.accel_columns.iter().any(Option::is_some)
     }
+
+    /// Every column the run uses is given by index: the file may have no column-name line.
+    fn by_index_only(&self) -> bool {
+        let cols = self
+            .time_column
+            .iter()
+            .chain(std::iter::once(&self.angle_column))
+            .chain(self.accel_columns.iter().flatten());
+        cols.clone().all(|c| matches!(c, ColumnRef::Index(_)))
+    }
 }
 
 /// A parsed data line, not yet accepted.
@@ -349,12 +392,18 @@ pub struct TimeseriesReader<R: BufRead> {
     header: Header,
     delim: Delimiter,
     columns: Vec<String>,
+    /// The line read as the column-name line (for a file without one, the first sample).
+    column_line_info: Option<LineInfo>,
+    /// A file without a column-name line: its first sample, read again as data.
+    first_data: Option<(LineInfo, Vec<u8>)>,
     ncols: usize,
     idx_time: Option<usize>,
     idx_angle: usize,
     idx_accel: [Option<usize>; 3],
     rad_per_unit: f64,
     line_no: u64,
+    /// Bytes read so far (where the next line starts).
+    byte_pos: u64,
     /// Data lines seen so far (good or bad): the sample index when times come from `sample_hz`.
     data_lines: u64,
     line: Vec<u8>,
@@ -557,12 +606,15 @@ impl<R: BufRead> TimeseriesReader<R> {
             opts,
             header: Header::new(),
             columns: Vec::new(),
+            column_line_info: None,
+            first_data: None,
             ncols: 0,
             idx_time: None,
             idx_angle: 0,
             idx_accel: [None; 3],
             rad_per_unit,
             line_no: 0,
+            byte_pos: 0,
             data_lines: 0,
             line: Vec::with_capacity(128),
             lookahead: VecDeque::new(),
@@ -643,7 +695,12 @@ impl<R: BufRead> TimeseriesReader<R> {
         self.fill_lookahead(BURST_PROBE_ROWS)?;
         let rows: Vec<Row> = self.lookahead.iter().copied().collect();
         let repeats = rows.windows(2).filter(|w| w[1].t_s == w[0].t_s).count();
-        let col = self.spec.time_column.clone().unwrap_or_default();
+        let col = self
+            .spec
+            .time_column
+            .as_ref()
+            .map(ToString::to_string)
+            .unwrap_or_default();
         let measured = burst_stats(&rows);
         let (rate_hz, interval_s) = match (&measured, self.spec.sample_hz) {
             (_, Some(hz)) => (hz, measured.as_ref().map_or(0.0, |b| b.interval_s)),
@@ -746,6 +803,18 @@ impl<R: BufRead> TimeseriesReader<R> {
     /// `self.line`).
     fn read_header(&mut self) -> Result<u64, RigError> {
         loop {
+            if self.byte_pos > crate::serial::MAX_HEADER_BYTES {
+                return Err(self.not_a_capture(
+                    self.line_no,
+                    format!(
+                        "the `#` header runs past {} bytes (line {}, byte {}) without a \
+                         column-name line",
+                        crate::serial::MAX_HEADER_BYTES,
+                        self.line_no,
+                        self.byte_pos
+                    ),
+                ));
+            }
             let Some(info) = self.read_line()? else {
                 // No line at all: the file is empty, which is the message a user needs.
                 let reason = if self.line_no == 0 {
@@ -758,7 +827,10 @@ impl<R: BufRead> TimeseriesReader<R> {
             if info.overlong {
                 return Err(self.not_a_capture(
                     info.number,
-                    format!("header line longer than {MAX_LINE_BYTES} bytes"),
+                    format!(
+                        "header line {} (from byte {}) is {} bytes, longer than {MAX_LINE_BYTES}",
+                        info.number, info.start, info.bytes
+                    ),
                 ));
             }
             let mut content: &[u8] = &self.line;
@@ -781,6 +853,7 @@ impl<R: BufRead> TimeseriesReader<R> {
                 continue;
             }
             self.line = text.into_bytes();
+            self.column_line_info = Some(info);
             return Ok(info.number);
         }
     }
@@ -802,33 +875,64 @@ impl<R: BufRead> TimeseriesReader<R> {
                     .to_string()
             })
             .collect();
-        if names.iter().all(|n| n.parse::<f64>().is_ok()) {
+        let headerless = names.iter().all(|n| n.parse::<f64>().is_ok());
+        if headerless && !self.spec.by_index_only() {
             return Err(self.not_a_capture(
                 line_number,
                 format!(
-                    "expected a column-name line (the file's columns must be named), found {}",
+                    "expected a column-name line (the file's columns must be named, or give \
+                     every column by its 0-based index: `time_column = 0`, `angle_column = 1`), \
+                     found {}",
                     snippet(&self.line)
                 ),
             ));
         }
-        self.columns = names;
+        if headerless {
+            // No column-name line: this line is the first sample, read again as data.
+            self.columns = (0..names.len()).map(|i| format!("#{i}")).collect();
+            if let Some(info) = self.column_line_info {
+                self.first_data = Some((info, std::mem::take(&mut self.line)));
+            }
+        } else {
+            self.columns = names;
+        }
         self.ncols = self.columns.len();
-        let find = |me: &Self, key: &str, name: &str| -> Result<usize, RigError> {
-            me.columns.iter().position(|c| c == name).ok_or_else(|| {
-                me.not_a_capture(
+        let find = |me: &Self, key: &str, col: &ColumnRef| -> Result<usize, RigError> {
+            let present = || {
+                format!(
+                    "{} (delimiter `{}`)",
+                    me.columns
+                        .iter()
+                        .map(|c| format!("`{c}`"))
+                        .collect::<Vec<_>>()
+                        .join(", "),
+                    me.delim.name()
+                )
+            };
+            match col {
+                ColumnRef::Name(name) => {
+                    me.columns.iter().position(|c| c == name).ok_or_else(|| {
+                        me.not_a_capture(
+                            line_number,
+                            format!(
+                                "column `{name}` (key `{key}`) not found; the columns present \
+                                 are: {}",
+                                present()
+                            ),
+                        )
+                    })
+                }
+                ColumnRef::Index(i) if *i < me.ncols => Ok(*i),
+                ColumnRef::Index(i) => Err(me.not_a_capture(
                     line_number,
                     format!(
-                        "column `{name}` (key `{key}`) not found; the columns present are: {} \
-                         (delimiter `{}`)",
-                        me.columns
-                            .iter()
-                            .map(|c| format!("`{c}`"))
-                            .collect::<Vec<_>>()
-                            .join(", "),
-                        me.delim.name()
+                        "column index {i} (key `{key}`, 0-based) is past the {} columns of the \
+                         file: {}",
+                        me.ncols,
+                        present()
                     ),
-                )
-            })
+                )),
+            }
         };
         if let Some(tc) = self.spec.time_column.clone() {
             self.idx_time = Some(find(self, "time_column", &tc)?);
@@ -854,10 +958,10 @@ impl<R: BufRead> TimeseriesReader<R> {
         h.set("columns", self.columns.join(","));
         h.set("delimiter", self.delim.name());
         match &s.time_column {
-            Some(c) => h.set("time_column", c.clone()),
+            Some(c) => h.set("time_column", c.to_string()),
             None => h.set("time_column", "none (sample index / sample_hz)"),
         }
-        h.set("angle_column", s.angle_column.clone());
+        h.set("angle_column", s.angle_column.to_string());
         h.set("angle_unit", s.angle_unit.as_str());
         h.set("hanging_angle", format!("{}", s.hanging_angle));
         // With any angle unit: the analysis takes the angle's resolution from it (issue 16).
@@ -870,7 +974,8 @@ impl<R: BufRead> TimeseriesReader<R> {
             for (i, c) in s.accel_columns.iter().enumerate() {
                 h.set(
                     format!("accel_{}_column", names[i]),
-                    c.clone().unwrap_or_else(|| "none (reads 0)".into()),
+                    c.as_ref()
+                        .map_or_else(|| "none (reads 0)".into(), ToString::to_string),
                 );
             }
             h.set(
@@ -894,6 +999,7 @@ impl<R: BufRead> TimeseriesReader<R> {
             &mut self.reader,
             &mut self.line,
             &mut self.line_no,
+            &mut self.byte_pos,
             MAX_LINE_BYTES,
         )
         .map_err(|e| RigError::io(&self.path, e))
@@ -902,8 +1008,15 @@ impl<R: BufRead> TimeseriesReader<R> {
     /// The next parsable data line; damaged ones are recorded and skipped.
     fn next_row(&mut self) -> Result<Option<Row>, RigError> {
         loop {
-            let Some(info) = self.read_line()? else {
-                return Ok(None);
+            let info = match self.first_data.take() {
+                Some((info, line)) => {
+                    self.line = line;
+                    info
+                }
+                None => match self.read_line()? {
+                    Some(info) => info,
+                    None => return Ok(None),
+                },
             };
             if self.line.iter().all(|b| b.is_ascii_whitespace()) && !info.overlong {
                 continue;
@@ -916,7 +1029,10 @@ impl<R: BufRead> TimeseriesReader<R> {
             if info.overlong {
                 self.stats.skip(
                     Location::Line(info.number),
-                    format!("line longer than {MAX_LINE_BYTES} bytes (garbage)"),
+                    format!(
+                        "line of {} bytes from byte {}, longer than {MAX_LINE_BYTES} (garbage)",
+                        info.bytes, info.start
+                    ),
                     info.bytes,
                 );
                 continue;
@@ -1158,7 +1274,7 @@ mod tests {
     #[test]
     fn keys_are_checked() {
         let s = spec("time_column = \"t_s\"\nangle_column = \"theta\"\nangle_unit = \"rad\"\nhanging_angle = 3.25");
-        assert_eq!(s.time_column.as_deref(), Some("t_s"));
+        assert_eq!(s.time_column, Some(ColumnRef::Name("t_s".into())));
         assert_eq!(s.angle_unit, AngleUnit::Rad);
         assert_eq!(s.hanging_angle, 3.25);
         let bad = |text: &str, key: &str| {
@@ -1468,7 +1584,7 @@ note = "kept"
         assert_eq!(r.extra["angle_column"].as_str(), Some("theta_rad"));
         assert_eq!(r.extra["note"].as_str(), Some("kept"));
         let s = TimeseriesSpec::from_run(r).unwrap();
-        assert_eq!(s.angle_column, "theta_rad");
+        assert_eq!(s.angle_column, ColumnRef::Name("theta_rad".into()));
         // Round trip: the unknown rig keys stay unknown.
         let text = c.to_toml_string().unwrap();
         let back = Campaign::parse(&text, "/d/campaign.toml").unwrap();

@@ -423,13 +423,65 @@ pub fn synthesize(case: &TwinCase, out_dir: &Path) -> Result<TwinSummary, RigErr
 }
 
 fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), RigError> {
-    let tmp = path.with_extension("tmp");
-    let io = |source| RigError::Io {
-        path: path.to_path_buf(),
-        source,
-    };
-    std::fs::write(&tmp, bytes).map_err(io)?;
-    std::fs::rename(&tmp, path).map_err(io)
+    let (tmp, mut file) = TempFile::create(path)?;
+    file.write_all(bytes)
+        .and_then(|()| file.sync_all())
+        .map_err(|source| RigError::Io {
+            path: tmp.path.clone(),
+            source,
+        })?;
+    drop(file);
+    tmp.persist(path)
+}
+
+/// A temporary file of this process beside its final path, `.NAME.<pid>-<n>.tmp` (the
+/// program's temporary-name pattern, which the commands' sweep of stale temporaries knows),
+/// created only if new: two processes writing one folder never share, truncate or rename away
+/// each other's (a fixed `campaign.tmp` let them). Removed when dropped unless persisted.
+struct TempFile {
+    path: PathBuf,
+    persisted: bool,
+}
+
+impl TempFile {
+    fn create(final_path: &Path) -> Result<(Self, File), RigError> {
+        static COUNTER: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+        let n = COUNTER.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        let name = final_path
+            .file_name()
+            .map(|f| f.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let path = final_path.with_file_name(format!(".{name}.{}-{n}.tmp", std::process::id()));
+        let file = File::create_new(&path).map_err(|source| RigError::Io {
+            path: path.clone(),
+            source,
+        })?;
+        Ok((
+            Self {
+                path,
+                persisted: false,
+            },
+            file,
+        ))
+    }
+
+    /// Renames the finished file into place.
+    fn persist(mut self, final_path: &Path) -> Result<(), RigError> {
+        std::fs::rename(&self.path, final_path).map_err(|source| RigError::Io {
+            path: final_path.to_path_buf(),
+            source,
+        })?;
+        self.persisted = true;
+        Ok(())
+    }
+}
+
+impl Drop for TempFile {
+    fn drop(&mut self) {
+        if !self.persisted {
+            let _ = std::fs::remove_file(&self.path);
+        }
+    }
 }
 
 fn synthesize_run(
@@ -694,12 +746,11 @@ fn synthesize_run(
         TwinFormat::Sd => format!("{}.bin", run.id),
     };
     let path = out_dir.join(&file_name);
-    let file = File::create(&path).map_err(|source| RigError::Io {
-        path: path.clone(),
-        source,
-    })?;
+    // Written under a temporary name and renamed into place whole: a killed synth leaves no
+    // half capture under the final name.
+    let (tmp, file) = TempFile::create(&path)?;
     let io = |source| RigError::Io {
-        path: path.clone(),
+        path: tmp.path.clone(),
         source,
     };
     match run.format {
@@ -805,6 +856,7 @@ fn synthesize_run(
             f.flush().map_err(io)?;
         }
     }
+    tmp.persist(&path)?;
     Ok(RunTruth {
         id: run.id.clone(),
         file: file_name,

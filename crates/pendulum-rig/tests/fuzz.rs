@@ -164,3 +164,131 @@ fn clean_files_read_whole() {
         "bursty stamps rebuilt strictly increasing"
     );
 }
+
+// ---- Issue 13 item 2: blocks off the timeline of any length, through the second reading. ----
+
+/// `n` rows every 5 ms from `t0`: a swing of ±500 counts and a table acceleration.
+fn swing_rows(n: usize, t0: u32) -> Vec<(u32, i16, [i16; 3])> {
+    (0..n)
+        .map(|k| {
+            let t = k as f64 * 0.005;
+            let enc = (500.0 * (std::f64::consts::TAU * 1.5 * t).sin()).round() as i16;
+            let az = 8192 + (2000.0 * (std::f64::consts::TAU * 1.54 * t).cos()).round() as i16;
+            (t0.wrapping_add(5000 * k as u32), enc, [12, -7, az])
+        })
+        .collect()
+}
+
+/// Reads a capture as ingest does (again with the plan while a reading finds blocks off the
+/// timeline): the kept encoder samples `(raw t, raw count, unwrapped t)` and the stats.
+fn read_planned(bytes: &[u8], sd: bool) -> (Vec<(u32, i16, u64)>, pendulum_rig::IngestStats) {
+    use pendulum_rig::{SdReader, SerialReader, TimelinePlan};
+    let mut plan: Option<TimelinePlan> = None;
+    let o = ReadOptions::default();
+    for reading in 1..=pendulum_rig::capture::MAX_READINGS {
+        let mut out = Vec::new();
+        let mut push = |s: Sample| {
+            if let Sample::Encoder(e) = s {
+                out.push((e.t_us_raw, e.count_raw, e.t_us));
+            }
+        };
+        let (stats, more) = if sd {
+            let mut r = SdReader::new(bytes, "f.bin", o).unwrap();
+            if let Some(p) = &plan {
+                r.set_timeline_plan(p.clone());
+            }
+            while let Some(s) = r.next_sample().unwrap() {
+                push(s);
+            }
+            (r.stats().clone(), r.timeline_plan())
+        } else {
+            let mut r = SerialReader::new(bytes, "f.csv", o).unwrap();
+            if let Some(p) = &plan {
+                r.set_timeline_plan(p.clone());
+            }
+            while let Some(s) = r.next_sample().unwrap() {
+                push(s);
+            }
+            (r.stats().clone(), r.timeline_plan())
+        };
+        match more {
+            Some(m) if reading < pendulum_rig::capture::MAX_READINGS => match &mut plan {
+                Some(p) => p.merge(m),
+                None => plan = Some(m),
+            },
+            _ => return (out, stats),
+        }
+    }
+    unreachable!()
+}
+
+proptest! {
+    #![proptest_config(fixed(24))]
+
+    /// One block of any length up to a third of the run (a few records to far beyond the
+    /// 512-record read-ahead), stamped seconds to half an hour ahead or behind, inserted anywhere
+    /// after the first 100 rows: every good record is kept on its own time base and the block's
+    /// records are all dropped as off the timeline. With several such blocks, or blocks that
+    /// replaced good rows, the readers never keep a record that was not written, and time
+    /// always increases.
+    #[test]
+    fn blocks_off_the_timeline_never_win(
+        n in 1500usize..4000,
+        sd in any::<bool>(),
+        blocks in prop::collection::vec(
+            (0.05f64..0.95, 0.001f64..0.33, prop_oneof![-1800i64..-5, 5i64..1800], any::<bool>()),
+            1..3,
+        ),
+    ) {
+        use pendulum_rig::{Header, SdWriter, SerialWriter};
+        let good = swing_rows(n, 2_000_000_000);
+        let mut rows = good.clone();
+        let mut shifted_total = 0usize;
+        let single_insert = blocks.len() == 1 && !blocks[0].3;
+        // Insert from the end so earlier positions stay valid.
+        let mut bs = blocks.clone();
+        bs.sort_by(|a, b| b.0.total_cmp(&a.0));
+        for &(at, len, shift_s, replace) in &bs {
+            let at = 100 + ((n - 200) as f64 * at) as usize;
+            let len = ((n as f64 * len) as usize).max(1).min(n - at);
+            let block: Vec<_> = good[at..at + len]
+                .iter()
+                .map(|&(t, e, a)| (t.wrapping_add((shift_s * 1_000_000) as u32), e, a))
+                .collect();
+            let end = if replace { at + len } else { at };
+            rows.splice(at..end, block);
+            shifted_total += len;
+        }
+        let bytes = if sd {
+            let mut w = SdWriter::new(
+                Vec::new(),
+                &Header::sd_v2().with("encoder_hz", "200").with("accel_hz", "200"),
+            )
+            .unwrap();
+            for &(t, e, a) in &rows {
+                w.write_encoder(t, e).unwrap();
+                w.write_accel(t, a).unwrap();
+            }
+            w.finish().unwrap()
+        } else {
+            let mut w = SerialWriter::new(Vec::new(), &Header::serial_v1()).unwrap();
+            for &(t, e, a) in &rows {
+                w.write_sample(t, e, a).unwrap();
+            }
+            w.finish().unwrap()
+        };
+        let (kept, st) = read_planned(&bytes, sd);
+        let written: std::collections::HashSet<(u32, i16)> = rows.iter().map(|r| (r.0, r.1)).collect();
+        prop_assert!(kept.iter().all(|k| written.contains(&(k.0, k.1))), "a record not written was kept");
+        prop_assert!(kept.windows(2).all(|w| w[0].2 < w[1].2), "time must increase");
+        if single_insert {
+            let want: Vec<(u32, i16)> = good.iter().map(|r| (r.0, r.1)).collect();
+            let got: Vec<(u32, i16)> = kept.iter().map(|k| (k.0, k.1)).collect();
+            prop_assert_eq!(got.len(), want.len(), "{:?}", st.warnings);
+            prop_assert!(got == want, "every good record kept");
+            let per_row = if sd { 2 } else { 1 };
+            prop_assert_eq!(st.off_timeline, (shifted_total * per_row) as u64);
+            prop_assert_eq!((st.gap_count, st.new_segments), (0, 0));
+        }
+    }
+}
