@@ -44,6 +44,8 @@ fn discover(seed: u64, base: Base, a: f64, b: f64, mu: f64, effects: &str) -> Di
         "params.parquet",
         "envelopes.parquet",
         "envelopes.png",
+        // Written last: the folder is complete (issue 13 item 6).
+        "complete.json",
     ] {
         assert!(Path::new(&s.out_dir).join(f).is_file(), "{f} missing");
     }

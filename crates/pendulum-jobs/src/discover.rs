@@ -141,6 +141,32 @@ pub const OUTPUTS: [&str; 6] = [
 ];
 
 pub fn run(job: &DiscoverJob) -> Result<DiscoverSummary, JobError> {
+    let began = std::time::SystemTime::now();
+    let summary = run_unmarked(job)?;
+    // The folder is one unit: marked complete last, naming the files this invocation wrote
+    // (`prepare_out_dir` removed any earlier marker before the work began).
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&summary.out_dir)
+        .map_err(|source| JobError::Io {
+            path: summary.out_dir.clone(),
+            source,
+        })?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| {
+            // Only what this invocation wrote (not a user's file, nor an earlier run's plot).
+            p.metadata()
+                .and_then(|m| m.modified())
+                .is_ok_and(|t| t >= began)
+                && p.file_name()
+                    .and_then(|n| n.to_str())
+                    .is_some_and(|n| !n.starts_with('.') && n != "complete.json")
+        })
+        .collect();
+    files.sort();
+    crate::outputs::mark_complete(&summary.out_dir, "pendulum discover", &files)?;
+    Ok(summary)
+}
+
+fn run_unmarked(job: &DiscoverJob) -> Result<DiscoverSummary, JobError> {
     let started = Instant::now();
     let mut pipe = load(job.pipeline.as_deref())?;
     for s in &mut pipe.stages {
