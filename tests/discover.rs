@@ -526,8 +526,9 @@ fn survey_issue_5_every_effect() {
     ];
     let mut pair_hits = 0;
     for (p_idx, (e1, e2)) in pairs.iter().enumerate() {
-        if one.is_some() {
-            break;
+        // `SURVEY_ONE=pair:N` re-runs pair N alone.
+        if one.as_deref().is_some_and(|o| o != format!("pair:{p_idx}")) {
+            continue;
         }
         let mut r = rng(3000 + p_idx as u64);
         let (t1, s1, _, _, _, _) = draw(e1, &mut r);
