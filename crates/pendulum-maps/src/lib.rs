@@ -21,6 +21,7 @@
 pub mod bifurcation;
 pub mod ics;
 pub mod params_file;
+pub mod shard;
 pub mod style;
 pub mod sweep;
 pub mod zones;
@@ -30,6 +31,7 @@ use std::path::PathBuf;
 pub use bifurcation::{Bifurcation, BifurcationConfig, Direction, Mode, Outcome};
 pub use ics::IcSpec;
 pub use params_file::{read_params, ParamsRow};
+pub use shard::{Manifest, Shard, ShardSet, ShardSpec};
 pub use sweep::{Sweep, SweepParam};
 pub use zones::{ZoneCell, ZoneConfig, ZoneMap};
 
