@@ -8,4 +8,5 @@ mod independent;
 mod ingest;
 mod maps;
 mod real;
+mod shard;
 mod util;

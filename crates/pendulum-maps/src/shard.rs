@@ -420,7 +420,10 @@ fn shard_dir_index(name: &str) -> Option<Result<usize, String>> {
 }
 
 fn list(v: &[usize]) -> String {
-    v.iter().map(|i| i.to_string()).collect::<Vec<_>>().join(", ")
+    v.iter()
+        .map(|i| i.to_string())
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 /// Reads and checks the shards in `dir`. Refused, with every problem named: no shard folders;
@@ -728,9 +731,8 @@ pub fn read_columns(path: &Path) -> Result<Vec<Column>, MapsError> {
         })
         .collect::<Result<_, MapsError>>()?;
     for batch in reader {
-        let batch = batch.map_err(|e| {
-            MapsError::Invalid(format!("{}: reading Parquet: {e}", path.display()))
-        })?;
+        let batch = batch
+            .map_err(|e| MapsError::Invalid(format!("{}: reading Parquet: {e}", path.display())))?;
         for (c, arr) in cols.iter_mut().zip(batch.columns()) {
             let bad = || {
                 MapsError::Invalid(format!(
@@ -972,7 +974,10 @@ mod tests {
         let cols = vec![
             Column::f64("x", "m", vec![1.0, f64::NAN, -0.0]),
             Column::new("n", ColumnData::I64(vec![1, 2, 3])).describe("count"),
-            Column::new("s", ColumnData::Str(vec!["a".into(), "b".into(), "c".into()])),
+            Column::new(
+                "s",
+                ColumnData::Str(vec!["a".into(), "b".into(), "c".into()]),
+            ),
             Column::new("b", ColumnData::Bool(vec![true, false, true])),
         ];
         let p = dir.path().join("t.parquet");
