@@ -253,8 +253,8 @@ pub struct MergeArgs {
 /// What the merge wrote: the one-machine summary of the map.
 #[derive(Debug, Clone)]
 pub enum Merged {
-    Bifurcate(BifurcateSummary),
-    Zones(ZonesSummary),
+    Bifurcate(Box<BifurcateSummary>),
+    Zones(Box<ZonesSummary>),
 }
 
 /// What `pendulum merge` did.
@@ -327,7 +327,7 @@ pub fn run(a: &MergeArgs) -> Result<MergeSummary, JobError> {
             let table = out.join("bifurcation.parquet");
             let rows = write_table(&table, &columns, &first.table_metadata)?;
             let figures = crate::bifurcate::write_figures(&result, &job.label, &out)?;
-            Merged::Bifurcate(BifurcateSummary {
+            Merged::Bifurcate(Box::new(BifurcateSummary {
                 label: job.label,
                 result,
                 ic_description: job.ic_description,
@@ -335,7 +335,7 @@ pub fn run(a: &MergeArgs) -> Result<MergeSummary, JobError> {
                 table,
                 rows,
                 figures,
-            })
+            }))
         }
         "zones" => {
             let job: ZonesJob =
@@ -349,19 +349,21 @@ pub fn run(a: &MergeArgs) -> Result<MergeSummary, JobError> {
             let table = out.join("zones.parquet");
             write_table(&table, &columns, &first.table_metadata)?;
             let (figures, comparison) = crate::zones::write_figures(&maps, &out)?;
-            Merged::Zones(ZonesSummary {
+            Merged::Zones(Box::new(ZonesSummary {
                 maps,
                 comparison,
                 ic_description: job.ic_description,
                 wall_s: wall_sum_s,
                 table,
                 figures,
-            })
+            }))
         }
-        other => return Err(JobError::Invalid(format!(
+        other => {
+            return Err(JobError::Invalid(format!(
             "{}: shards of command {other:?}, which this pendulum cannot merge (bifurcate, zones)",
             a.dir.display()
-        ))),
+        )))
+        }
     };
     Ok(MergeSummary {
         dir: a.dir.clone(),

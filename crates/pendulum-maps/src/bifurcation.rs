@@ -121,7 +121,7 @@ impl BifurcationConfig {
             Mode::Continuation => {
                 let (i, dir) = (
                     cell / 2,
-                    if cell % 2 == 0 {
+                    if cell.is_multiple_of(2) {
                         Direction::Up
                     } else {
                         Direction::Down
@@ -269,7 +269,7 @@ pub fn run_cells(
                     .map(|&c| {
                         let (i, dir) = (
                             c / 2,
-                            if c % 2 == 0 {
+                            if c.is_multiple_of(2) {
                                 Direction::Up
                             } else {
                                 Direction::Down
@@ -321,7 +321,9 @@ pub fn merge_shards(
         )));
     }
     // Each part's rows split into outcomes (a new one starts at k = 0), grouped by cell.
-    let mut cell_rows: Vec<Option<(usize, Vec<(usize, usize)>)>> = vec![None; cfg.cells()];
+    // Per cell: the shard holding it and its simulations' row ranges in that shard's table.
+    type CellRows = Option<(usize, Vec<(usize, usize)>)>;
+    let mut cell_rows: Vec<CellRows> = vec![None; cfg.cells()];
     for (s, (m, part)) in set.manifests.iter().zip(&set.parts).enumerate() {
         let ColumnData::I64(k) = col(part, "k")? else {
             return Err(MapsError::Invalid("column k is not an integer".into()));
