@@ -132,29 +132,44 @@ fn shards() {
     );
     println!("run                                            wall [s]   CPU [s]   CPU/wall   periods/core-s   speed-up vs baseline");
     let tmp = std::env::temp_dir().join(format!("pendulum-bench-maps-{}", std::process::id()));
-    let base_dir = tmp.join("one");
-    let (base_wall, base_cpu) = run_shards(0, &base_dir);
-    let base_pages = data_pages(&base_dir.join("zones.parquet"));
-    println!(
-        "{:<46} {base_wall:>9.2} {base_cpu:>9.2} {:>10.2} {:>16.0} {:>22.2}",
-        "one process, 1 thread (baseline)",
-        base_cpu / base_wall,
-        periods / base_cpu,
-        1.0
-    );
-    for n in [1usize, 2] {
-        let dir = tmp.join(format!("n{n}"));
-        let (wall, cpu) = run_shards(n, &dir);
-        assert!(
-            data_pages(&dir.join("zones.parquet")) == base_pages,
-            "{n} shards merged to other rows than the baseline"
-        );
+    // Rounds of (baseline, 1 shard, 2 shards), interleaved so that the machine's other load
+    // falls on all three alike; each run's best round is printed (the least disturbed).
+    let rounds: usize = std::env::var("PENDULUM_BENCH_ROUNDS")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(3)
+        .max(1);
+    let runs = [0usize, 1, 2];
+    let mut best = [(f64::INFINITY, 0.0f64); 3];
+    let base_dir = tmp.join("n0");
+    for _ in 0..rounds {
+        for (k, &n) in runs.iter().enumerate() {
+            let dir = tmp.join(format!("n{n}"));
+            let _ = std::fs::remove_dir_all(&dir);
+            let (wall, cpu) = run_shards(n, &dir);
+            if n > 0 {
+                assert!(
+                    data_pages(&dir.join("zones.parquet"))
+                        == data_pages(&base_dir.join("zones.parquet")),
+                    "{n} shards merged to other rows than the baseline"
+                );
+            }
+            if wall < best[k].0 {
+                best[k] = (wall, cpu);
+            }
+        }
+    }
+    println!("(best of {rounds} interleaved rounds)");
+    let base_wall = best[0].0;
+    for (k, &n) in runs.iter().enumerate() {
+        let (wall, cpu) = best[k];
+        let label = match n {
+            0 => "one process, 1 thread (baseline)".to_string(),
+            1 => "1 shard, 1 thread, + merge".to_string(),
+            n => format!("{n} shards at once, 1 thread each, + merge"),
+        };
         println!(
-            "{:<46} {wall:>9.2} {cpu:>9.2} {:>10.2} {:>16.0} {:>22.2}",
-            format!(
-                "{n} shard{} at once, 1 thread each, + merge",
-                if n == 1 { "" } else { "s" }
-            ),
+            "{label:<46} {wall:>9.2} {cpu:>9.2} {:>10.2} {:>16.0} {:>22.2}",
             cpu / wall,
             periods / cpu,
             base_wall / wall
