@@ -302,30 +302,28 @@ pub fn run_cells(
         let mut cells = Vec::with_capacity(cell_list.len());
         for &c in cell_list {
             let (ix, iy) = (c % nx, c / nx);
-            {
-                let mut counts = [0usize; 5];
-                let (mut speed_sum, mut n_rot) = (0.0, 0usize);
-                for st in it.by_ref().take(ns) {
-                    counts[class_index(st.class)] += 1;
-                    if st.class.is_rotation() {
-                        speed_sum += st.mean_theta_dot.abs();
-                        n_rot += 1;
-                    }
+            let mut counts = [0usize; 5];
+            let (mut speed_sum, mut n_rot) = (0.0, 0usize);
+            for st in it.by_ref().take(ns) {
+                counts[class_index(st.class)] += 1;
+                if st.class.is_rotation() {
+                    speed_sum += st.mean_theta_dot.abs();
+                    n_rot += 1;
                 }
-                cells.push(ZoneCell {
-                    ix,
-                    iy,
-                    x: cfg.x.values[ix],
-                    y: cfg.y.values[iy],
-                    counts,
-                    starts: ns,
-                    mean_rotation_speed: if n_rot > 0 {
-                        speed_sum / n_rot as f64
-                    } else {
-                        f64::NAN
-                    },
-                });
             }
+            cells.push(ZoneCell {
+                ix,
+                iy,
+                x: cfg.x.values[ix],
+                y: cfg.y.values[iy],
+                counts,
+                starts: ns,
+                mean_rotation_speed: if n_rot > 0 {
+                    speed_sum / n_rot as f64
+                } else {
+                    f64::NAN
+                },
+            });
         }
         maps.push(ZoneMap {
             label: label.clone(),
