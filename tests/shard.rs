@@ -329,8 +329,20 @@ fn issue_15_merge_refuses_missing_duplicated_and_mixed_shards() {
     let good = root.path().join("good");
     for i in 0..3 {
         let s = format!("{i}/3");
+        // The thread count is no part of the configuration: shards may differ in it.
+        let threads = (i + 1).to_string();
         ok(&run_bin(
-            &args(BIFURCATE, &["--shard", &s, "--out", good.to_str().unwrap()]),
+            &args(
+                BIFURCATE,
+                &[
+                    "--shard",
+                    &s,
+                    "--threads",
+                    &threads,
+                    "--out",
+                    good.to_str().unwrap(),
+                ],
+            ),
             &[],
         ));
     }
