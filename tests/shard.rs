@@ -416,6 +416,18 @@ fn issue_15_merge_refuses_missing_duplicated_and_mixed_shards() {
         e.contains("SHA-256 differs") && e.contains("run shard 1 again"),
         "{e}"
     );
+    // A manifest edited by hand (its configuration no longer hashes to its config_hash).
+    let d = case("edited");
+    let m = d.join("shard=2/manifest.json");
+    let text = std::fs::read_to_string(&m).unwrap();
+    let edited = text.replacen("\"transient_periods\": 60", "\"transient_periods\": 61", 1);
+    assert_ne!(text, edited, "the manifest records transient_periods");
+    std::fs::write(&m, edited).unwrap();
+    let e = err(&merge(&d));
+    assert!(
+        e.contains("shard=2") && e.contains("edited or damaged"),
+        "{e}"
+    );
     // Nothing to merge.
     let e = err(&merge(root.path()));
     assert!(e.contains("no shard=I folders"), "{e}");
