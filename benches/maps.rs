@@ -8,6 +8,16 @@
 //! the cores (the load average printed first shows it too), and periods per CPU-second equal
 //! across thread counts mean the parallel sweep costs nothing extra per core. Checks that both
 //! thread counts give identical results. Asserts nothing about time.
+//!
+//! Then the sharded map (issue 15): a `pendulum zones` map (ω 0.5..3.5 step 0.1 × R 0.4..1.0
+//! step 0.1 = 217 cells, 4×4 starts, 200 + 32 periods, the reference model) run by the built
+//! binary as one process on one thread (the baseline), as 1 shard and as 2 shards running at
+//! once (one thread each, as a Slurm array with `--cpus-per-task=1` would), each followed by
+//! `pendulum merge`; prints forcing periods per core-second (CPU time of the child processes)
+//! and each wall time as a ratio to the baseline's, and checks that each merge wrote the
+//! baseline's data pages. CPU/wall below the number of processes running at once means other
+//! processes had the cores (the load average is printed). `-- shards` runs this part alone,
+//! `-- threads` the first.
 
 use std::time::Instant;
 
@@ -39,7 +49,149 @@ fn cpu_s() -> Option<f64> {
     Some(ticks / 100.0)
 }
 
+/// CPU time of this process's waited-for children, in seconds (Linux; USER_HZ = 100).
+fn children_cpu_s() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+    let rest = stat.rsplit_once(')')?.1;
+    let f: Vec<&str> = rest.split_whitespace().collect();
+    // cutime and cstime are fields 16 and 17.
+    let ticks: f64 = f.get(13)?.parse::<f64>().ok()? + f.get(14)?.parse::<f64>().ok()?;
+    Some(ticks / 100.0)
+}
+
+const ZONES: &[&str] = &[
+    "zones",
+    "--study",
+    "reference",
+    "--x",
+    "omega=0.5:3.5:0.1",
+    "--y",
+    "R=0.4:1.0:0.1",
+    "--ic-grid",
+    "4x4",
+    "--transient",
+    "200",
+    "--record",
+    "32",
+    "--threads",
+    "1",
+    "--quiet",
+];
+
+/// Runs `n` shards of the map at once (0 = the unsharded baseline), then the merge; returns
+/// the wall time and the children's CPU time.
+fn run_shards(n: usize, out: &std::path::Path) -> (f64, f64) {
+    let bin = env!("CARGO_BIN_EXE_pendulum");
+    let cpu0 = children_cpu_s().unwrap_or(0.0);
+    let start = Instant::now();
+    let jobs: Vec<(usize, std::process::Child)> = (0..n.max(1))
+        .map(|i| {
+            let mut c = std::process::Command::new(bin);
+            c.args(ZONES).arg("--out").arg(out);
+            if n > 0 {
+                c.arg("--shard").arg(format!("{i}/{n}"));
+            }
+            (
+                i,
+                c.stdout(std::process::Stdio::null())
+                    .spawn()
+                    .expect("spawn pendulum"),
+            )
+        })
+        .collect();
+    for (i, mut c) in jobs {
+        assert!(c.wait().expect("wait").success(), "shard {i} of {n} failed");
+    }
+    if n > 0 {
+        let s = std::process::Command::new(bin)
+            .arg("merge")
+            .arg(out)
+            .stdout(std::process::Stdio::null())
+            .status()
+            .expect("spawn merge");
+        assert!(s.success(), "merge failed");
+    }
+    let wall = start.elapsed().as_secs_f64();
+    (wall, children_cpu_s().unwrap_or(0.0) - cpu0)
+}
+
+/// The Parquet data pages (everything before the footer, which holds the invocation id).
+fn data_pages(path: &std::path::Path) -> Vec<u8> {
+    let b = std::fs::read(path).expect("read table");
+    let n = u32::from_le_bytes(b[b.len() - 8..b.len() - 4].try_into().expect("footer")) as usize;
+    b[..b.len() - 8 - n].to_vec()
+}
+
+fn shards() {
+    let cells = 31 * 7;
+    let periods = (cells * 16 * (200 + 32)) as f64;
+    let load = std::fs::read_to_string("/proc/loadavg").unwrap_or_default();
+    println!(
+        "\nsharded zones map: ω 0.5..3.5 step 0.1 × R 0.4..1.0 step 0.1 = {cells} cells × 16 starts, 200 + 32 periods = {periods:.0} forcing periods; load average {}",
+        load.split_whitespace().take(3).collect::<Vec<_>>().join(" ")
+    );
+    println!("run                                            wall [s]   CPU [s]   CPU/wall   periods/core-s   speed-up vs baseline");
+    let tmp = std::env::temp_dir().join(format!("pendulum-bench-maps-{}", std::process::id()));
+    // Rounds of (baseline, 1 shard, 2 shards), interleaved so that the machine's other load
+    // falls on all three alike; each run's best round is printed (the least disturbed).
+    let rounds: usize = std::env::var("PENDULUM_BENCH_ROUNDS")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(3)
+        .max(1);
+    let runs = [0usize, 1, 2];
+    let mut best = [(f64::INFINITY, 0.0f64); 3];
+    let base_dir = tmp.join("n0");
+    for _ in 0..rounds {
+        for (k, &n) in runs.iter().enumerate() {
+            let dir = tmp.join(format!("n{n}"));
+            let _ = std::fs::remove_dir_all(&dir);
+            let (wall, cpu) = run_shards(n, &dir);
+            if n > 0 {
+                assert!(
+                    data_pages(&dir.join("zones.parquet"))
+                        == data_pages(&base_dir.join("zones.parquet")),
+                    "{n} shards merged to other rows than the baseline"
+                );
+            }
+            if wall < best[k].0 {
+                best[k] = (wall, cpu);
+            }
+        }
+    }
+    println!("(best of {rounds} interleaved rounds)");
+    let base_wall = best[0].0;
+    for (k, &n) in runs.iter().enumerate() {
+        let (wall, cpu) = best[k];
+        let label = match n {
+            0 => "one process, 1 thread (baseline)".to_string(),
+            1 => "1 shard, 1 thread, + merge".to_string(),
+            n => format!("{n} shards at once, 1 thread each, + merge"),
+        };
+        println!(
+            "{label:<46} {wall:>9.2} {cpu:>9.2} {:>10.2} {:>16.0} {:>22.2}",
+            cpu / wall,
+            periods / cpu,
+            base_wall / wall
+        );
+    }
+    let _ = std::fs::remove_dir_all(&tmp);
+}
+
 fn main() {
+    let only: Vec<String> = std::env::args()
+        .skip(1)
+        .filter(|a| a == "shards" || a == "threads")
+        .collect();
+    if only.is_empty() || only.iter().any(|a| a == "threads") {
+        threads();
+    }
+    if only.is_empty() || only.iter().any(|a| a == "shards") {
+        shards();
+    }
+}
+
+fn threads() {
     let models: Vec<String> = {
         let args: Vec<String> = std::env::args()
             .skip(1)

@@ -8,5 +8,6 @@ mod independent;
 mod ingest;
 mod maps;
 mod real;
+mod shard;
 mod unexplained;
 mod util;

@@ -36,6 +36,9 @@ enum Command {
     Bifurcate(pendulum_jobs::bifurcate::BifurcateArgs),
     /// Rotation-zone maps over two swept parameters, two models compared: Parquet and PNGs.
     Zones(pendulum_jobs::zones::ZonesArgs),
+    /// Merge the shards of a map (`bifurcate`/`zones --shard I/N --out DIR`) into the table and
+    /// figures the one-machine run writes; refuses missing shards and mixed configurations.
+    Merge(pendulum_jobs::merge::MergeArgs),
     /// Replay a run with a fitted model: measured channels plus /sim/theta in one MCAP file.
     Replay(pendulum_jobs::replay::ReplayArgs),
     /// Identify damping by the study's method (align, initial conditions, DE fit, validation);
@@ -367,6 +370,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         }
         Command::Bifurcate(a) => out!("{}", pendulum_jobs::bifurcate::run(&a)?),
         Command::Zones(a) => out!("{}", pendulum_jobs::zones::run(&a)?),
+        Command::Merge(a) => out!("{}", pendulum_jobs::merge::run(&a)?),
         Command::Replay(a) => out!("{}", pendulum_jobs::replay::run(&a)?),
         Command::Demo(a) => {
             outln!(

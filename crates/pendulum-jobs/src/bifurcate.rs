@@ -16,6 +16,7 @@ use pendulum_maps::{IcSpec, MapsError, Sweep};
 use pendulum_model::{ClassifyOptions, Dimensionless, ParamSpec, Physical, SimOptions};
 
 use crate::inputs::Inputs;
+use crate::merge::Ran;
 use crate::JobError;
 
 impl From<MapsError> for JobError {
@@ -277,7 +278,10 @@ pub struct BifurcateArgs {
     pub continuation: bool,
     #[command(flatten)]
     pub run: RunArgs,
-    /// Output folder (bifurcation.parquet, bifurcation.png, bifurcation_classes.png).
+    #[command(flatten)]
+    pub shard: crate::merge::ShardArgs,
+    /// Output folder (bifurcation.parquet, bifurcation.png, bifurcation_classes.png; with
+    /// --shard, shard=I/part.parquet and shard=I/manifest.json).
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
 }
@@ -390,8 +394,8 @@ impl std::fmt::Display for BifurcateSummary {
     }
 }
 
-/// Runs `pendulum bifurcate`.
-pub fn run(a: &BifurcateArgs) -> Result<BifurcateSummary, JobError> {
+/// Runs `pendulum bifurcate`: the whole sweep, or with `--shard` one shard of it.
+pub fn run(a: &BifurcateArgs) -> Result<Ran<BifurcateSummary>, JobError> {
     let model = a.model.resolve()?;
     let sweep = Sweep::parse(&a.sweep)?;
     let ics = a.ics.spec("8x8")?;
@@ -407,17 +411,54 @@ pub fn run(a: &BifurcateArgs) -> Result<BifurcateSummary, JobError> {
     cfg.classify = ClassifyOptions::default();
     cfg.threads = a.run.threads;
     cfg.validate()?;
+    let shard = a.shard.resolve()?;
     // Before the sweep: none of the outputs may replace the --params file.
     let mut inputs = Inputs::new();
     if let Some(p) = &a.model.params_file {
         inputs.add("--params", p);
     }
-    for name in [
-        "bifurcation.parquet",
-        "bifurcation.png",
-        "bifurcation_classes.png",
-    ] {
-        inputs.check_output("the output", &a.out.join(name))?;
+    let names: Vec<PathBuf> = match shard {
+        Some(s) => [pendulum_maps::shard::PART, pendulum_maps::shard::MANIFEST]
+            .iter()
+            .map(|n| a.out.join(s.dir_name()).join(n))
+            .collect(),
+        None => [
+            "bifurcation.parquet",
+            "bifurcation.png",
+            "bifurcation_classes.png",
+        ]
+        .iter()
+        .map(|n| a.out.join(n))
+        .collect(),
+    };
+    for p in &names {
+        inputs.check_output("the output", p)?;
+    }
+    let extra = vec![
+        ("command".to_string(), "pendulum bifurcate".to_string()),
+        ("model".to_string(), model.label.clone()),
+        ("assignments".to_string(), model.assignments.join(" ")),
+        ("initial_states".to_string(), ics.describe()),
+    ];
+    if let Some(s) = shard {
+        let job = crate::merge::BifurcateJob {
+            config: cfg.clone(),
+            label: model.label.clone(),
+            ic_description: ics.describe(),
+        };
+        let empty = Bifurcation {
+            config: cfg,
+            outcomes: Vec::new(),
+        };
+        let mut md = empty.metadata();
+        md.extend(extra);
+        return Ok(Ran::Shard(crate::merge::bifurcate_shard(
+            &job,
+            &md,
+            s,
+            &a.out,
+            !a.run.quiet,
+        )?));
     }
     create_dir(&a.out)?;
     let bar = progress_bar(cfg.tasks(), "bifurcate", !a.run.quiet);
@@ -426,25 +467,30 @@ pub fn run(a: &BifurcateArgs) -> Result<BifurcateSummary, JobError> {
     bar.finish_and_clear();
     let wall_s = t.elapsed().as_secs_f64();
     let table = a.out.join("bifurcation.parquet");
-    let extra = vec![
-        ("command".to_string(), "pendulum bifurcate".to_string()),
-        ("model".to_string(), model.label.clone()),
-        ("assignments".to_string(), model.assignments.join(" ")),
-        ("initial_states".to_string(), ics.describe()),
-    ];
     let written = result.write_parquet(&table, &extra)?;
-    let title = result.default_title(&model.label);
-    let png = a.out.join("bifurcation.png");
-    result.plot(&png, &title)?;
-    let classes = a.out.join("bifurcation_classes.png");
-    result.plot_fractions(&classes, &format!("Steady states along the sweep, {title}"))?;
-    Ok(BifurcateSummary {
+    let figures = write_figures(&result, &model.label, &a.out)?;
+    Ok(Ran::Full(BifurcateSummary {
         label: model.label,
         result,
         ic_description: ics.describe(),
         wall_s,
         table,
         rows: written.rows,
-        figures: vec![png, classes],
-    })
+        figures,
+    }))
+}
+
+/// The diagram and the class fractions, `bifurcation.png` and `bifurcation_classes.png` in
+/// `out` (one-machine run and merge alike).
+pub(crate) fn write_figures(
+    result: &Bifurcation,
+    label: &str,
+    out: &Path,
+) -> Result<Vec<PathBuf>, JobError> {
+    let title = result.default_title(label);
+    let png = out.join("bifurcation.png");
+    result.plot(&png, &title)?;
+    let classes = out.join("bifurcation_classes.png");
+    result.plot_fractions(&classes, &format!("Steady states along the sweep, {title}"))?;
+    Ok(vec![png, classes])
 }

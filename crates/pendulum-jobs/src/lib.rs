@@ -8,6 +8,7 @@ pub mod discover;
 pub mod identify;
 pub mod ingest;
 pub mod inputs;
+pub mod merge;
 pub mod outputs;
 pub mod replay;
 pub mod runs;

@@ -14,6 +14,7 @@ use crate::bifurcate::{
     ResolvedModel, RunArgs, Study,
 };
 use crate::inputs::Inputs;
+use crate::merge::Ran;
 use crate::JobError;
 
 /// `pendulum zones` options.
@@ -42,7 +43,10 @@ pub struct ZonesArgs {
     pub ics: IcArgs,
     #[command(flatten)]
     pub run: RunArgs,
-    /// Output folder (zones.parquet, zones_<model>.png, zones_compare.png).
+    #[command(flatten)]
+    pub shard: crate::merge::ShardArgs,
+    /// Output folder (zones.parquet, zones_<model>.png, zones_compare.png; with --shard,
+    /// shard=I/part.parquet and shard=I/manifest.json).
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
 }
@@ -161,6 +165,45 @@ fn slug(s: &str) -> String {
         .collect()
 }
 
+/// The table's metadata beyond the grid's: the command, each model's assignments, the starts.
+fn table_extra(
+    models: &[ResolvedModel],
+    ic_description: &str,
+    extra: &[(String, String)],
+) -> Vec<(String, String)> {
+    let mut meta = vec![("command".to_string(), "pendulum zones".to_string())];
+    for m in models {
+        meta.push((format!("assignments.{}", m.label), m.assignments.join(" ")));
+    }
+    meta.push(("initial_states".to_string(), ic_description.to_string()));
+    meta.extend(extra.iter().cloned());
+    meta
+}
+
+/// Each model's heat maps (`zones_<model>.png`) and, for two models, `zones_compare.png`
+/// (one-machine run and merge alike).
+pub(crate) fn write_figures(
+    maps: &[ZoneMap],
+    out: &Path,
+) -> Result<(Vec<PathBuf>, Option<Comparison>), JobError> {
+    let mut figures = Vec::new();
+    for m in maps {
+        let p = out.join(format!("zones_{}.png", slug(&m.label)));
+        m.plot(&p)?;
+        figures.push(p);
+    }
+    let comparison = match maps {
+        [a, b] => {
+            let p = out.join("zones_compare.png");
+            let cmp = zones::plot_comparison(a, b, &p)?;
+            figures.push(p);
+            Some(cmp)
+        }
+        _ => None,
+    };
+    Ok((figures, comparison))
+}
+
 /// Runs the maps of `models` on `cfg` and writes the table and figures into `out`.
 pub fn run_models(
     models: &[ResolvedModel],
@@ -179,28 +222,9 @@ pub fn run_models(
     bar.finish_and_clear();
     let wall_s = t.elapsed().as_secs_f64();
     let table = out.join("zones.parquet");
-    let mut meta = vec![("command".to_string(), "pendulum zones".to_string())];
-    for m in models {
-        meta.push((format!("assignments.{}", m.label), m.assignments.join(" ")));
-    }
-    meta.push(("initial_states".to_string(), ic_description.to_string()));
-    meta.extend(extra.iter().cloned());
+    let meta = table_extra(models, ic_description, extra);
     zones::write_parquet(&maps, &table, &meta)?;
-    let mut figures = Vec::new();
-    for m in &maps {
-        let p = out.join(format!("zones_{}.png", slug(&m.label)));
-        m.plot(&p)?;
-        figures.push(p);
-    }
-    let comparison = match maps.as_slice() {
-        [a, b] => {
-            let p = out.join("zones_compare.png");
-            let cmp = zones::plot_comparison(a, b, &p)?;
-            figures.push(p);
-            Some(cmp)
-        }
-        _ => None,
-    };
+    let (figures, comparison) = write_figures(&maps, out)?;
     Ok(ZonesSummary {
         maps,
         comparison,
@@ -237,8 +261,8 @@ fn models_of(a: &ZonesArgs) -> Result<Vec<ResolvedModel>, JobError> {
     Ok(models)
 }
 
-/// Runs `pendulum zones`.
-pub fn run(a: &ZonesArgs) -> Result<ZonesSummary, JobError> {
+/// Runs `pendulum zones`: the whole map, or with `--shard` one shard of it.
+pub fn run(a: &ZonesArgs) -> Result<Ran<ZonesSummary>, JobError> {
     let models = models_of(a)?;
     let ics = a.ics.spec("4x4")?;
     let mut cfg = ZoneConfig::new(Sweep::parse(&a.x)?, Sweep::parse(&a.y)?, ics.starts());
@@ -246,21 +270,70 @@ pub fn run(a: &ZonesArgs) -> Result<ZonesSummary, JobError> {
     cfg.record_periods = a.run.record;
     cfg.sim = a.run.sim()?;
     cfg.threads = a.run.threads;
+    let shard = a.shard.resolve()?;
     // Before the maps: none of the outputs may replace the --params file.
     let mut inputs = Inputs::new();
     if let Some(p) = &a.model.params_file {
         inputs.add("--params", p);
     }
-    let mut outputs = vec!["zones.parquet".to_string(), "zones_compare.png".to_string()];
-    outputs.extend(
-        models
+    let mut outputs: Vec<PathBuf> = match shard {
+        Some(s) => [pendulum_maps::shard::PART, pendulum_maps::shard::MANIFEST]
             .iter()
-            .map(|m| format!("zones_{}.png", slug(&m.label))),
-    );
-    for name in outputs {
-        inputs.check_output("the output", &a.out.join(name))?;
+            .map(|n| a.out.join(s.dir_name()).join(n))
+            .collect(),
+        None => vec![a.out.join("zones.parquet"), a.out.join("zones_compare.png")],
+    };
+    if shard.is_none() {
+        outputs.extend(
+            models
+                .iter()
+                .map(|m| a.out.join(format!("zones_{}.png", slug(&m.label)))),
+        );
     }
-    run_models(&models, &cfg, &ics.describe(), &a.out, !a.run.quiet, &[])
+    for p in &outputs {
+        inputs.check_output("the output", p)?;
+    }
+    let Some(s) = shard else {
+        return Ok(Ran::Full(run_models(
+            &models,
+            &cfg,
+            &ics.describe(),
+            &a.out,
+            !a.run.quiet,
+            &[],
+        )?));
+    };
+    // The table's metadata as the one-machine run writes it (it depends on the grid and the
+    // models, not on the cells).
+    let empty: Vec<ZoneMap> = models
+        .iter()
+        .map(|m| ZoneMap {
+            label: m.label.clone(),
+            base: m.params,
+            config: cfg.clone(),
+            cells: Vec::new(),
+        })
+        .collect();
+    let md = zones::metadata(&empty, &table_extra(&models, &ics.describe(), &[]))?;
+    let job = crate::merge::ZonesJob {
+        config: cfg,
+        models: models
+            .iter()
+            .map(|m| crate::merge::ZonesModel {
+                label: m.label.clone(),
+                assignments: m.assignments.clone(),
+                params: m.params,
+            })
+            .collect(),
+        ic_description: ics.describe(),
+    };
+    Ok(Ran::Shard(crate::merge::zones_shard(
+        &job,
+        &md,
+        s,
+        &a.out,
+        !a.run.quiet,
+    )?))
 }
 
 /// The demo's closing comparison: the study's dry-friction (reference) and linear models on a

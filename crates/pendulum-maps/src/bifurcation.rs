@@ -93,6 +93,54 @@ impl BifurcationConfig {
         }
     }
 
+    /// Cells: the units a sharded run deals out ([`crate::shard`]), in table order. Grid mode:
+    /// one (value, start) simulation, cell `v·starts + i`; continuation: one chain, cell
+    /// `2·i + d` (d = 0 up, 1 down), each of `values` simulations.
+    pub fn cells(&self) -> usize {
+        match self.mode {
+            Mode::Grid => self.sweep.len() * self.starts.len(),
+            Mode::Continuation => 2 * self.starts.len(),
+        }
+    }
+
+    /// What one cell is, in words.
+    pub fn cell_description(&self) -> &'static str {
+        match self.mode {
+            Mode::Grid => "one (sweep value, start) simulation; cell = value_index·starts + ic",
+            Mode::Continuation => {
+                "one continuation chain (a start swept up or down); cell = 2·ic + (0 up, 1 down)"
+            }
+        }
+    }
+
+    /// The simulations of a cell, in table order: (value index, start index, direction).
+    fn cell_outcomes(&self, cell: usize) -> Vec<(usize, usize, Direction)> {
+        let (nv, ns) = (self.sweep.len(), self.starts.len());
+        match self.mode {
+            Mode::Grid => vec![(cell / ns, cell % ns, Direction::Grid)],
+            Mode::Continuation => {
+                let (i, dir) = (
+                    cell / 2,
+                    if cell.is_multiple_of(2) {
+                        Direction::Up
+                    } else {
+                        Direction::Down
+                    },
+                );
+                (0..nv)
+                    .map(|step| {
+                        let v = if dir == Direction::Up {
+                            step
+                        } else {
+                            nv - 1 - step
+                        };
+                        (v, i, dir)
+                    })
+                    .collect()
+            }
+        }
+    }
+
     pub fn validate(&self) -> Result<(), MapsError> {
         if self.sweep.is_empty() {
             return Err(MapsError::Invalid("the sweep has no values".into()));
@@ -184,30 +232,49 @@ pub fn run(
     cfg: &BifurcationConfig,
     progress: &(dyn Fn(u64) + Sync),
 ) -> Result<Bifurcation, MapsError> {
+    let all: Vec<usize> = (0..cfg.cells()).collect();
+    run_cells(cfg, &all, progress)
+}
+
+/// Runs the given cells ([`BifurcationConfig::cells`], ascending) of the sweep: the outcomes are
+/// those of [`run`] for these cells, in the same order (a shard's share of the map).
+pub fn run_cells(
+    cfg: &BifurcationConfig,
+    cells: &[usize],
+    progress: &(dyn Fn(u64) + Sync),
+) -> Result<Bifurcation, MapsError> {
     cfg.validate()?;
+    let total = cfg.cells();
+    if let Some(&bad) = cells.iter().find(|&&c| c >= total) {
+        return Err(MapsError::Invalid(format!(
+            "cell {bad} is beyond the sweep's {total} cells"
+        )));
+    }
     let nv = cfg.sweep.len();
+    let ns = cfg.starts.len();
     let outcomes = with_pool(cfg.threads, || -> Result<Vec<Outcome>, MapsError> {
         match cfg.mode {
-            Mode::Grid => {
-                let tasks: Vec<(usize, usize)> = (0..nv)
-                    .flat_map(|v| (0..cfg.starts.len()).map(move |i| (v, i)))
-                    .collect();
-                tasks
-                    .par_iter()
-                    .map(|&(v, i)| {
-                        let o = simulate_one(cfg, v, i, Direction::Grid, cfg.starts[i]);
-                        progress(1);
-                        o
-                    })
-                    .collect()
-            }
+            Mode::Grid => cells
+                .par_iter()
+                .map(|&c| {
+                    let (v, i) = (c / ns, c % ns);
+                    let o = simulate_one(cfg, v, i, Direction::Grid, cfg.starts[i]);
+                    progress(1);
+                    o
+                })
+                .collect(),
             Mode::Continuation => {
-                let chains: Vec<(usize, Direction)> = (0..cfg.starts.len())
-                    .flat_map(|i| [(i, Direction::Up), (i, Direction::Down)])
-                    .collect();
-                let per_chain: Vec<Vec<Outcome>> = chains
+                let per_chain: Vec<Vec<Outcome>> = cells
                     .par_iter()
-                    .map(|&(i, dir)| {
+                    .map(|&c| {
+                        let (i, dir) = (
+                            c / 2,
+                            if c.is_multiple_of(2) {
+                                Direction::Up
+                            } else {
+                                Direction::Down
+                            },
+                        );
                         let mut y = cfg.starts[i];
                         let mut out = Vec::with_capacity(nv);
                         for step in 0..nv {
@@ -234,6 +301,127 @@ pub fn run(
         config: cfg.clone(),
         outcomes,
     })
+}
+
+/// Merges the shards of a sweep ([`crate::shard::read_shards`]): the table, the shards' rows in
+/// the one-machine order (byte for byte the values [`Bifurcation::columns`] gives), and the
+/// sweep rebuilt from them for the figures and summaries. The rebuilt outcomes hold θ wrapped
+/// to [−π, π) as the table does (the figures use θ̇ alone).
+pub fn merge_shards(
+    cfg: &BifurcationConfig,
+    set: &crate::shard::ShardSet,
+) -> Result<(Bifurcation, Vec<Column>), MapsError> {
+    use crate::shard::col;
+    cfg.validate()?;
+    if set.first().cells_total != cfg.cells() {
+        return Err(MapsError::Invalid(format!(
+            "the shards deal {} cells, the sweep has {}",
+            set.first().cells_total,
+            cfg.cells()
+        )));
+    }
+    // Each part's rows split into outcomes (a new one starts at k = 0), grouped by cell.
+    // Per cell: the shard holding it and its simulations' row ranges in that shard's table.
+    type CellRows = Option<(usize, Vec<(usize, usize)>)>;
+    let mut cell_rows: Vec<CellRows> = vec![None; cfg.cells()];
+    for (s, (m, part)) in set.manifests.iter().zip(&set.parts).enumerate() {
+        let ColumnData::I64(k) = col(part, "k")? else {
+            return Err(MapsError::Invalid("column k is not an integer".into()));
+        };
+        let mut starts: Vec<usize> = (0..k.len()).filter(|&r| k[r] == 0).collect();
+        starts.push(k.len());
+        let outcomes: Vec<(usize, usize)> = starts.windows(2).map(|w| (w[0], w[1])).collect();
+        let per_cell = match cfg.mode {
+            Mode::Grid => 1,
+            Mode::Continuation => cfg.sweep.len(),
+        };
+        if outcomes.len() != m.cells.len() * per_cell || starts[0] != 0 && !k.is_empty() {
+            return Err(MapsError::Invalid(format!(
+                "shard {}: {} simulations in its table, {} expected for its {} cells",
+                m.shard,
+                outcomes.len(),
+                m.cells.len() * per_cell,
+                m.cells.len()
+            )));
+        }
+        for (j, &c) in m.cells.iter().enumerate() {
+            cell_rows[c] = Some((s, outcomes[j * per_cell..(j + 1) * per_cell].to_vec()));
+        }
+    }
+    let mut order = Vec::new();
+    let mut outcomes = Vec::new();
+    for (c, entry) in cell_rows.iter().enumerate() {
+        let Some((s, ranges)) = entry else {
+            return Err(MapsError::Invalid(format!("no shard holds cell {c}")));
+        };
+        let part = &set.parts[*s];
+        let (
+            ColumnData::I64(ic),
+            ColumnData::Str(dir),
+            ColumnData::F64(th0),
+            ColumnData::F64(w0),
+            ColumnData::F64(th),
+            ColumnData::F64(w),
+            ColumnData::Str(class),
+            ColumnData::I64(period),
+            ColumnData::F64(speed),
+        ) = (
+            col(part, "ic")?,
+            col(part, "direction")?,
+            col(part, "theta0")?,
+            col(part, "theta_dot0")?,
+            col(part, "theta")?,
+            col(part, "theta_dot")?,
+            col(part, "class")?,
+            col(part, "period")?,
+            col(part, "mean_theta_dot")?,
+        )
+        else {
+            return Err(MapsError::Invalid(
+                "the shard tables' columns are not of the bifurcation table's types".into(),
+            ));
+        };
+        for (&(r0, r1), (v, i, d)) in ranges.iter().zip(cfg.cell_outcomes(c)) {
+            if ic[r0] != i as i64 || dir[r0] != d.as_str() {
+                return Err(MapsError::Invalid(format!(
+                    "shard {}: row {r0} is start {} ({}), cell {c} expects start {i} ({})",
+                    set.manifests[*s].shard,
+                    ic[r0],
+                    dir[r0],
+                    d.as_str()
+                )));
+            }
+            let class_of = SteadyClass::ALL
+                .into_iter()
+                .find(|k| k.as_str() == class[r0])
+                .ok_or_else(|| {
+                    MapsError::Invalid(format!("unknown steady class {:?}", class[r0]))
+                })?;
+            outcomes.push(Outcome {
+                value_index: v,
+                value: cfg.sweep.values[v],
+                ic: i,
+                direction: d,
+                start: [th0[r0], w0[r0]],
+                steady: SteadyState {
+                    class: class_of,
+                    period: u32::try_from(period[r0]).unwrap_or(0),
+                    mean_theta_dot: speed[r0],
+                },
+                theta: th[r0..r1].to_vec(),
+                theta_dot: w[r0..r1].to_vec(),
+            });
+            order.extend((r0..r1).map(|r| (*s, r)));
+        }
+    }
+    let columns = crate::shard::gather(&set.parts, &order)?;
+    Ok((
+        Bifurcation {
+            config: cfg.clone(),
+            outcomes,
+        },
+        columns,
+    ))
 }
 
 /// 1400 px, wider when the title would not fit (about 14 px per character at that size).

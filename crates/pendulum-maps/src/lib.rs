@@ -10,6 +10,9 @@
 //!   cell by cell with the cells where one rotates and the other does not marked.
 //! * [`ics`]: the initial states (a θ0 × θ̇0 grid, seeded random draws, or a list).
 //! * [`sweep`]: `omega=0.5:3.5:0.01`-style sweep specifications.
+//! * [`shard`]: a map split into shards (`--shard I/N`, or from a Slurm array or a Kubernetes
+//!   Indexed Job), each writing `OUT/shard=I/part.parquet` and a manifest, and the checks and
+//!   row order of `pendulum merge`.
 //! * [`params_file`]: the model rows of `params.parquet` (written by `pendulum identify`) as
 //!   parameter assignments.
 //!
@@ -21,6 +24,7 @@
 pub mod bifurcation;
 pub mod ics;
 pub mod params_file;
+pub mod shard;
 pub mod style;
 pub mod sweep;
 pub mod zones;
@@ -30,6 +34,7 @@ use std::path::PathBuf;
 pub use bifurcation::{Bifurcation, BifurcationConfig, Direction, Mode, Outcome};
 pub use ics::IcSpec;
 pub use params_file::{read_params, ParamsRow};
+pub use shard::{Manifest, Shard, ShardSet, ShardSpec};
 pub use sweep::{Sweep, SweepParam};
 pub use zones::{ZoneCell, ZoneConfig, ZoneMap};
 

@@ -98,6 +98,12 @@ impl ZoneConfig {
         Ok(())
     }
 
+    /// Cells of the map, `nx·ny`; cell `iy·nx + ix` is (ix, iy), the table's order. The unit a
+    /// sharded run deals out ([`crate::shard`]), with all its starts and all models.
+    pub fn cells(&self) -> usize {
+        self.x.len() * self.y.len()
+    }
+
     /// `base` with both swept parameters set to cell (ix, iy).
     pub fn cell_params(&self, base: &Dimensionless, ix: usize, iy: usize) -> Dimensionless {
         let d = self.x.apply(base, ix);
@@ -243,13 +249,31 @@ pub fn run(
     cfg: &ZoneConfig,
     progress: &(dyn Fn(u64) + Sync),
 ) -> Result<Vec<ZoneMap>, MapsError> {
+    let all: Vec<usize> = (0..cfg.cells()).collect();
+    run_cells(models, cfg, &all, progress)
+}
+
+/// Runs the given cells (`iy·nx + ix`, ascending) of every model: maps holding just these
+/// cells, each as [`run`] computes it (a shard's share of the map).
+pub fn run_cells(
+    models: &[(String, Dimensionless)],
+    cfg: &ZoneConfig,
+    cell_list: &[usize],
+    progress: &(dyn Fn(u64) + Sync),
+) -> Result<Vec<ZoneMap>, MapsError> {
     cfg.validate(models)?;
-    let (nx, ny, ns) = (cfg.x.len(), cfg.y.len(), cfg.starts.len());
+    let (nx, ns) = (cfg.x.len(), cfg.starts.len());
+    if let Some(&bad) = cell_list.iter().find(|&&c| c >= cfg.cells()) {
+        return Err(MapsError::Invalid(format!(
+            "cell {bad} is beyond the map's {} cells",
+            cfg.cells()
+        )));
+    }
     let tasks: Vec<(usize, usize, usize, usize)> = (0..models.len())
         .flat_map(|m| {
-            (0..ny).flat_map(move |iy| {
-                (0..nx).flat_map(move |ix| (0..ns).map(move |s| (m, ix, iy, s)))
-            })
+            cell_list
+                .iter()
+                .flat_map(move |&c| (0..ns).map(move |s| (m, c % nx, c / nx, s)))
         })
         .collect();
     let results = with_pool(cfg.threads, || {
@@ -275,32 +299,31 @@ pub fn run(
     let mut maps = Vec::with_capacity(models.len());
     let mut it = results.into_iter();
     for (label, base) in models {
-        let mut cells = Vec::with_capacity(nx * ny);
-        for iy in 0..ny {
-            for ix in 0..nx {
-                let mut counts = [0usize; 5];
-                let (mut speed_sum, mut n_rot) = (0.0, 0usize);
-                for st in it.by_ref().take(ns) {
-                    counts[class_index(st.class)] += 1;
-                    if st.class.is_rotation() {
-                        speed_sum += st.mean_theta_dot.abs();
-                        n_rot += 1;
-                    }
+        let mut cells = Vec::with_capacity(cell_list.len());
+        for &c in cell_list {
+            let (ix, iy) = (c % nx, c / nx);
+            let mut counts = [0usize; 5];
+            let (mut speed_sum, mut n_rot) = (0.0, 0usize);
+            for st in it.by_ref().take(ns) {
+                counts[class_index(st.class)] += 1;
+                if st.class.is_rotation() {
+                    speed_sum += st.mean_theta_dot.abs();
+                    n_rot += 1;
                 }
-                cells.push(ZoneCell {
-                    ix,
-                    iy,
-                    x: cfg.x.values[ix],
-                    y: cfg.y.values[iy],
-                    counts,
-                    starts: ns,
-                    mean_rotation_speed: if n_rot > 0 {
-                        speed_sum / n_rot as f64
-                    } else {
-                        f64::NAN
-                    },
-                });
             }
+            cells.push(ZoneCell {
+                ix,
+                iy,
+                x: cfg.x.values[ix],
+                y: cfg.y.values[iy],
+                counts,
+                starts: ns,
+                mean_rotation_speed: if n_rot > 0 {
+                    speed_sum / n_rot as f64
+                } else {
+                    f64::NAN
+                },
+            });
         }
         maps.push(ZoneMap {
             label: label.clone(),
@@ -451,29 +474,139 @@ pub fn columns(maps: &[ZoneMap]) -> Result<Vec<Column>, MapsError> {
     Ok(cols)
 }
 
-/// Writes [`columns`] to Parquet with the grid's description and `extra` in the metadata.
+/// The table's key-value metadata: the grid's description, the models' parameters, `extra`.
+pub fn metadata(
+    maps: &[ZoneMap],
+    extra: &[(String, String)],
+) -> Result<Vec<(String, String)>, MapsError> {
+    let Some(first) = maps.first() else {
+        return Err(MapsError::Invalid("no maps to write".into()));
+    };
+    let c = &first.config;
+    let mut md = vec![
+        ("x".to_string(), c.x.describe()),
+        ("y".to_string(), c.y.describe()),
+        ("starts".to_string(), c.starts.len().to_string()),
+        (
+            "transient_periods".to_string(),
+            c.transient_periods.to_string(),
+        ),
+        ("record_periods".to_string(), c.record_periods.to_string()),
+        ("tol".to_string(), c.sim.rtol.to_string()),
+    ];
+    for m in maps {
+        md.push((
+            format!("params.{}", m.label),
+            serde_json::to_string(&m.base).unwrap_or_default(),
+        ));
+    }
+    md.extend(extra.iter().cloned());
+    Ok(md)
+}
+
+/// Writes [`columns`] to Parquet with [`metadata`] (the grid's description and `extra`).
 pub fn write_parquet(
     maps: &[ZoneMap],
     path: &Path,
     extra: &[(String, String)],
 ) -> Result<TableSummary, MapsError> {
     let cols = columns(maps)?;
-    let c = &maps[0].config;
-    let mut opts = TableOptions::new()
-        .meta("x", c.x.describe())
-        .meta("y", c.y.describe())
-        .meta("starts", c.starts.len().to_string())
-        .meta("transient_periods", c.transient_periods.to_string())
-        .meta("record_periods", c.record_periods.to_string())
-        .meta("tol", c.sim.rtol.to_string());
-    for m in maps {
-        opts = opts.meta(
-            &format!("params.{}", m.label),
-            serde_json::to_string(&m.base).unwrap_or_default(),
-        );
-    }
-    for (k, v) in extra {
-        opts = opts.meta(k, v.clone());
+    let mut opts = TableOptions::new();
+    for (k, v) in metadata(maps, extra)? {
+        opts = opts.meta(&k, v);
     }
     Ok(opts.write(path, &cols)?)
+}
+
+/// Merges the shards of a zones run ([`crate::shard::read_shards`]): the table, the shards' rows
+/// in the one-machine order (model by model, cell by cell), and the maps rebuilt from them for
+/// the figures and summaries. Each cell's class counts are recovered from its fractions and
+/// checked to give them back bit for bit.
+pub fn merge_shards(
+    models: &[(String, Dimensionless)],
+    cfg: &ZoneConfig,
+    set: &crate::shard::ShardSet,
+) -> Result<(Vec<ZoneMap>, Vec<Column>), MapsError> {
+    use crate::shard::col;
+    cfg.validate(models)?;
+    let total = cfg.cells();
+    if set.first().cells_total != total {
+        return Err(MapsError::Invalid(format!(
+            "the shards deal {} cells, the map has {total}",
+            set.first().cells_total
+        )));
+    }
+    let owner = set.cell_owner();
+    let (nx, ns) = (cfg.x.len(), cfg.starts.len());
+    let mut order = Vec::with_capacity(models.len() * total);
+    let mut maps = Vec::with_capacity(models.len());
+    for (mi, (label, base)) in models.iter().enumerate() {
+        let mut cells = Vec::with_capacity(total);
+        for (c, &(s, j)) in owner.iter().enumerate() {
+            if s == usize::MAX {
+                return Err(MapsError::Invalid(format!("no shard holds cell {c}")));
+            }
+            let m = &set.manifests[s];
+            let r = mi * m.cells.len() + j;
+            let part = &set.parts[s];
+            let (
+                ColumnData::Str(model),
+                ColumnData::I64(starts),
+                ColumnData::F64(speed),
+                ColumnData::F64(rot),
+            ) = (
+                col(part, "model")?,
+                col(part, "starts")?,
+                col(part, "mean_rotation_speed")?,
+                col(part, "rotation_fraction")?,
+            )
+            else {
+                return Err(MapsError::Invalid(
+                    "the shard tables' columns are not of the zones table's types".into(),
+                ));
+            };
+            if r >= model.len() || model[r] != *label || starts[r] != ns as i64 {
+                return Err(MapsError::Invalid(format!(
+                    "shard {}: row {r} is not model {label}'s cell {c} with {ns} starts",
+                    m.shard
+                )));
+            }
+            let mut counts = [0usize; 5];
+            for (k, cl) in SteadyClass::ALL.iter().enumerate() {
+                let ColumnData::F64(f) = col(part, &format!("{}_fraction", cl.as_str()))? else {
+                    return Err(MapsError::Invalid("a fraction column is not f64".into()));
+                };
+                counts[k] = (f[r] * ns as f64).round() as usize;
+            }
+            let cell = ZoneCell {
+                ix: c % nx,
+                iy: c / nx,
+                x: cfg.x.values[c % nx],
+                y: cfg.y.values[c / nx],
+                counts,
+                starts: ns,
+                mean_rotation_speed: speed[r],
+            };
+            let same = SteadyClass::ALL.iter().all(|cl| {
+                matches!(col(part, &format!("{}_fraction", cl.as_str())),
+                    Ok(ColumnData::F64(f)) if f[r].to_bits() == cell.fraction(*cl).to_bits())
+            }) && rot[r].to_bits() == cell.rotation_fraction().to_bits();
+            if !same {
+                return Err(MapsError::Invalid(format!(
+                    "shard {}: row {r}'s fractions are not counts out of {ns} starts",
+                    m.shard
+                )));
+            }
+            cells.push(cell);
+            order.push((s, r));
+        }
+        maps.push(ZoneMap {
+            label: label.clone(),
+            base: *base,
+            config: cfg.clone(),
+            cells,
+        });
+    }
+    let columns = crate::shard::gather(&set.parts, &order)?;
+    Ok((maps, columns))
 }
