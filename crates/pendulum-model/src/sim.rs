@@ -39,6 +39,19 @@ impl Model {
         }
     }
 
+    /// The model of `phys` in the clock its captures are aligned on (t = 0 at the accelerometer's
+    /// peak), through the shared sensor transform ([`crate::Sensors`]): with `accel_delay` the
+    /// accelerometer lags, so the true forcing leads that clock by Δ. Fit, discover and replay
+    /// all build their models here ([`Model::new`] alone would drop the delay).
+    pub fn measured(phys: &crate::Physical) -> Self {
+        let d = phys.to_dimensionless();
+        let mut m = Model::new(d);
+        if let Excitation::Crank(c) = &mut m.excitation {
+            c.phi0 = crate::Sensors::of(phys).forcing_lead_rad(d.omega, phys.omega0_rad_s());
+        }
+        m
+    }
+
     /// Same parameters, another excitation.
     pub fn with_excitation(params: Dimensionless, excitation: Excitation) -> Self {
         Self {
