@@ -58,7 +58,13 @@ pub enum FitParam {
 }
 
 /// A free-decay parameter: (it, spec name, column name, unit, bounds).
-type FreeDecayParam = (FitParam, &'static str, &'static str, &'static str, (f64, f64));
+type FreeDecayParam = (
+    FitParam,
+    &'static str,
+    &'static str,
+    &'static str,
+    (f64, f64),
+);
 
 /// Free-decay parameters (identifiable ratios: not the catalogue's SI ones).
 const FREE_DECAY: [FreeDecayParam; 5] = [

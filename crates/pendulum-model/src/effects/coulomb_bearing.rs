@@ -30,6 +30,9 @@ impl Effect for CoulombBearing {
             draws: &[("mu", Draw::Uniform(0.08, 0.2))],
         }
     }
+    fn in_physical(&self) -> bool {
+        true
+    }
     fn get(&self, p: &Physical) -> Option<Vec<f64>> {
         Some(vec![p.mu])
     }

@@ -154,6 +154,12 @@ pub trait Effect: Sync + std::fmt::Debug {
     /// The survey's design for this effect hidden alone.
     fn survey(&self) -> Survey;
 
+    /// Whether its values live in [`Physical`] itself (the reference model's a, b, μ) rather
+    /// than in [`Effects`].
+    fn in_physical(&self) -> bool {
+        false
+    }
+
     /// The effect's SI values in `p` (`None`: absent). The reference model's own terms override
     /// this: their values live in [`Physical`]'s a, b, μ.
     fn get(&self, p: &Physical) -> Option<Vec<f64>> {
@@ -396,32 +402,44 @@ enum Raw {
 }
 
 impl Serialize for Effects {
+    /// Every stored effect in the catalogue's order, an absent one as `null` (a switch as
+    /// `false`): the form truth files had before the catalogue, which readers of them expect.
+    /// TOML leaves the nulls out.
     fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        let mut map = BTreeMap::new();
-        for (e, v) in self.iter() {
+        use serde::ser::SerializeMap;
+        let stored: Vec<&dyn Effect> = CATALOGUE
+            .iter()
+            .copied()
+            .filter(|e| !e.in_physical())
+            .collect();
+        let mut map = s.serialize_map(Some(stored.len()))?;
+        for e in stored {
             let ps = e.params();
-            match ps.len() {
-                0 => map.insert(e.name().to_string(), Raw::Switch(true)),
-                1 => map.insert(format!("{}_{}", e.name(), ps[0].field), Raw::Number(v[0])),
-                _ => map.insert(
-                    e.name().to_string(),
-                    Raw::Table(
+            let v = self.get(e.name());
+            let key = serial_key(e);
+            match (ps.len(), v) {
+                (0, v) => map.serialize_entry(&key, &Raw::Switch(v.is_some()))?,
+                (_, None) => map.serialize_entry(&key, &Option::<Raw>::None)?,
+                (1, Some(v)) => map.serialize_entry(&key, &Raw::Number(v[0]))?,
+                (_, Some(v)) => map.serialize_entry(
+                    &key,
+                    &Raw::Table(
                         ps.iter()
                             .map(|p| p.field.to_string())
                             .zip(v.iter().copied())
                             .collect(),
                     ),
-                ),
-            };
+                )?,
+            }
         }
-        map.serialize(s)
+        map.end()
     }
 }
 
 impl<'de> Deserialize<'de> for Effects {
     fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
         use serde::de::Error;
-        let raw = BTreeMap::<String, Raw>::deserialize(d)?;
+        let raw = BTreeMap::<String, Option<Raw>>::deserialize(d)?;
         let mut out = Effects::default();
         for (key, value) in raw {
             let found = CATALOGUE.iter().copied().find(|e| serial_key(*e) == key);
@@ -433,6 +451,8 @@ impl<'de> Deserialize<'de> for Effects {
                 )));
             };
             let ps = e.params();
+            // `null`: absent (truth files list every effect).
+            let Some(value) = value else { continue };
             let vals = match (value, ps.len()) {
                 (Raw::Switch(on), 0) => on.then(Vec::new),
                 (Raw::Number(v), 1) => Some(vec![v]),

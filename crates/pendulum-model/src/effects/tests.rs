@@ -110,6 +110,19 @@ speed_drift_hz_per_s = 0.001
     // serde's own form too.
     let s = toml::to_string(&e).unwrap();
     assert_eq!(toml::from_str::<Effects>(&s).unwrap(), e);
+    // JSON as truth files have it: every effect, absent ones null (read back the same).
+    let json = serde_json::to_string(&e).unwrap();
+    assert_eq!(serde_json::from_str::<Effects>(&json).unwrap(), e);
+    let none = serde_json::to_value(Effects::default()).unwrap();
+    assert_eq!(none["coulomb_constant_t_c_nm"], serde_json::Value::Null);
+    assert_eq!(
+        none["bearing_load_base_accel"],
+        serde_json::Value::Bool(false)
+    );
+    assert_eq!(
+        serde_json::from_value::<Effects>(none).unwrap(),
+        Effects::default()
+    );
     // A switch set to false is absent.
     let off: Effects = toml::from_str("bearing_load_base_accel = false").unwrap();
     assert!(off.is_empty());

@@ -32,6 +32,9 @@ impl Effect for ViscousLinear {
         }
     }
     // The reference terms live in `Physical` itself (every model has them, 0 = absent).
+    fn in_physical(&self) -> bool {
+        true
+    }
     fn get(&self, p: &Physical) -> Option<Vec<f64>> {
         Some(vec![p.b_n_s_m])
     }

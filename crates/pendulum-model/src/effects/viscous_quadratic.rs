@@ -30,6 +30,9 @@ impl Effect for ViscousQuadratic {
             draws: &[("a", Draw::Uniform(0.05, 0.2))],
         }
     }
+    fn in_physical(&self) -> bool {
+        true
+    }
     fn get(&self, p: &Physical) -> Option<Vec<f64>> {
         Some(vec![p.a_kg_m])
     }
