@@ -199,6 +199,12 @@ pub struct Dimensionless {
     pub base_load: bool,
     /// Crank speed drift dω/dt in dimensionless units.
     pub omega_drift: f64,
+    /// Dry torque fading with speed, s·e^{−(θ̇/v)²} sgn θ̇, held in full at rest: its size
+    /// s (a torque per m g l) and speed scale v (dimensionless, > 0 when s ≠ 0). Absent = 0.
+    #[serde(default)]
+    pub s_break: f64,
+    #[serde(default)]
+    pub v_break: f64,
     /// Linear restoring stiffness κ = k/(m g l) of a torque −k θ besides gravity (a torsion
     /// spring, a cable): free decays of spring-loaded pendulums (issue 16). Absent = 0.
     #[serde(default)]
@@ -229,6 +235,8 @@ impl Dimensionless {
             j: 0.0,
             base_load: false,
             omega_drift: 0.0,
+            s_break: 0.0,
+            v_break: 0.0,
             kappa: 0.0,
         }
     }
@@ -254,6 +262,12 @@ impl Dimensionless {
             ("c", self.c, self.c >= 0.0),
             ("j", self.j, self.j > -1.0),
             ("kappa", self.kappa, self.kappa >= 0.0),
+            ("s_break", self.s_break, self.s_break >= 0.0),
+            (
+                "v_break",
+                self.v_break,
+                self.v_break >= 0.0 && (self.s_break == 0.0 || self.v_break > 0.0),
+            ),
         ];
         for (name, v, ok) in checks {
             if !(v.is_finite() && ok) {
@@ -263,6 +277,7 @@ impl Dimensionless {
                     expected: match name {
                         "lambda" => "0 ≤ λ < 1".into(),
                         "j" => "j > −1".into(),
+                        "v_break" => "v > 0 when s > 0".into(),
                         _ => "a finite value ≥ 0".into(),
                     },
                 });
