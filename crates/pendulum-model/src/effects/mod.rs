@@ -30,6 +30,7 @@ mod extra_inertia;
 mod horizontal_base;
 mod position_torque;
 mod speed_drift;
+mod stribeck;
 mod viscous_linear;
 mod viscous_quadratic;
 
@@ -41,6 +42,7 @@ pub static CATALOGUE: &[&dyn Effect] = &[
     &bearing_load_base_accel::BearingLoadBaseAccel,
     &coulomb_constant::CoulombConstant,
     &position_torque::PositionTorque,
+    &stribeck::Stribeck,
     &horizontal_base::HorizontalBase,
     &extra_inertia::ExtraInertia,
     &encoder_offset::EncoderOffset,
