@@ -386,72 +386,73 @@ fn regression_issue_5_finds_dry_torque_and_position_torque_together() {
     assert_pair_found(3000, 7000, "coulomb_constant", "position_torque");
 }
 
+/// Issue 14: breakaway friction (`stribeck`) hidden alone on a drawn design is named alone,
+/// within 25 % of its T_s, and not mistaken for the constant dry torque it resembles at speed.
+/// Fails today (7.7 s): discover's screen (weak.rs TERMS, screen.rs candidates) does not take its
+/// columns from the catalogue yet, so stribeck is no candidate: nothing is named (every row
+/// screened out, held-out E_θ 5.5170 → 5.5170), coulomb_constant's screen estimate is 2.5e-5 N·m
+/// (interval −3.8e-4…4.3e-4, not named); only the free-segment envelopes show a dry torque
+/// (coulomb_constant 2.157e-3 N·m, truth T_s = 1.083e-2 N·m at v_s = 0.258 rad/s).
+#[test]
+#[ignore = "known failure (issue 14): discover's screen has no stribeck column until weak.rs/screen.rs read the catalogue"]
+fn issue_14_finds_stribeck_and_tells_it_from_coulomb_constant() {
+    let s = found_when_hidden("stribeck", 14_000, 14_001);
+    assert!(!s.discovery.accepted().contains(&"coulomb_constant"));
+}
+
 /// A drawn size of one hidden effect: (truth in the diagnosis's unit, the twin's effects table
-/// line, base, a, b, μ). Ranges as in the regression tests above.
+/// lines, base, a, b, μ), from the effect's catalogue entry (`Effect::survey`): the base model
+/// that lacks it, then its parameters drawn in the entry's order (the first is the truth).
 fn draw(effect: &str, r: &mut rand_chacha::ChaCha8Rng) -> (f64, String, Base, f64, f64, f64) {
-    let sign = |r: &mut rand_chacha::ChaCha8Rng| if r.random::<bool>() { 1.0 } else { -1.0 };
-    match effect {
-        "coulomb_bearing" => {
-            let mu = r.random_range(0.08..0.2);
-            (mu, String::new(), Base::Linear, 0.0, 0.3, mu)
-        }
-        "viscous_quadratic" => {
-            let a = r.random_range(0.05..0.2);
-            (a, String::new(), Base::Linear, a, 0.3, 0.0)
-        }
-        "viscous_linear" => {
-            let b = r.random_range(0.3..0.7);
-            (b, String::new(), Base::Dry, 0.0, b, 0.15)
-        }
-        "bearing_load_base_accel" => {
-            let mu = r.random_range(0.1..0.2);
-            let s = "bearing_load_base_accel = true".to_string();
-            (mu, s, Base::Reference, 0.0, 0.5, mu)
-        }
-        _ => {
-            let (t, s) = match effect {
-                "coulomb_constant" => {
-                    let v = r.random_range(0.006..0.015);
-                    (v, format!("coulomb_constant_t_c_nm = {v}"))
-                }
-                "position_torque" => {
-                    let v = r.random_range(0.015..0.04);
-                    let k = r.random_range(1..=4);
-                    let phi = r.random_range(-3.0..3.0);
-                    (
-                        v,
-                        format!("position_torque = {{ t_p_nm = {v}, k = {k}, phi_p_rad = {phi} }}"),
-                    )
-                }
-                "horizontal_base" => {
-                    let v = r.random_range(0.02..0.08) * sign(r);
-                    (v, format!("horizontal_base_delta_rad = {v}"))
-                }
-                "extra_inertia" => {
-                    let v = r.random_range(0.005..0.02);
-                    (v, format!("extra_inertia_j_kg_m2 = {v}"))
-                }
-                "encoder_offset" => {
-                    let v = r.random_range(0.02..0.08) * sign(r);
-                    (v, format!("encoder_offset_rad = {v}"))
-                }
-                "accel_delay" => {
-                    let v = r.random_range(0.004..0.015);
-                    (v, format!("accel_delay_s = {v}"))
-                }
-                "accel_gain" => {
-                    let v = r.random_range(0.02..0.08) * sign(r);
-                    (v, format!("accel_gain_k_a = {v}"))
-                }
-                "speed_drift" => {
-                    let v = r.random_range(0.0005..0.002) * sign(r);
-                    (v, format!("speed_drift_hz_per_s = {v}"))
-                }
-                other => panic!("no draw for {other}"),
-            };
-            (t, s, Base::Reference, 0.0, 0.5, 0.15)
-        }
+    use pendulum_model::effects::{by_name, Draw};
+    let e = by_name(effect).unwrap_or_else(|| panic!("no catalogue effect {effect}"));
+    let survey = e.survey();
+    // The base models' own damping when the effect is absent (the study's representative fit;
+    // b = 0.3 is the classic linear model's).
+    let (base, a, b, mu) = match survey.base {
+        "linear" => (Base::Linear, 0.0, 0.3, 0.0),
+        "dry" => (Base::Dry, 0.0, 0.0, 0.15),
+        "reference" => (Base::Reference, 0.0, 0.5, 0.15),
+        other => panic!("{effect}: unknown survey base {other}"),
+    };
+    let mut p = pendulum_model::Physical {
+        a_kg_m: a,
+        b_n_s_m: b,
+        mu,
+        ..pendulum_model::Physical::default()
+    };
+    if e.get(&p).is_none() {
+        // Switched on (a switch has no parameter to draw).
+        let unset: Vec<f64> = e.params().iter().map(|q| q.unset).collect();
+        e.set(&mut p, Some(&unset));
     }
+    let sign = |r: &mut rand_chacha::ChaCha8Rng| if r.random::<bool>() { 1.0 } else { -1.0 };
+    let mut assignments = Vec::new();
+    for (key, d) in survey.draws {
+        let v = match *d {
+            Draw::Uniform(lo, hi) => r.random_range(lo..hi),
+            // The size first, then the sign (the order the note's designs were drawn in).
+            Draw::Signed(lo, hi) => {
+                let v = r.random_range(lo..hi);
+                v * sign(r)
+            }
+            Draw::Int(lo, hi) => f64::from(r.random_range(lo..=hi)),
+        };
+        assignments.push(format!("{key}={v}"));
+    }
+    let truth: f64 = assignments[0].split_once('=').unwrap().1.parse().unwrap();
+    pendulum_model::ParamSpec::parse(&assignments)
+        .unwrap()
+        .apply_physical(&mut p)
+        .unwrap();
+    (
+        truth,
+        p.effects.toml_lines(),
+        base,
+        p.a_kg_m,
+        p.b_n_s_m,
+        p.mu,
+    )
 }
 
 /// Survey (slow, by hand with `--ignored`): every catalogue effect hidden alone
@@ -464,7 +465,9 @@ fn survey_issue_5_every_effect() {
         .ok()
         .and_then(|v| v.parse().ok())
         .unwrap_or(3);
-    let effects = [
+    // The order the note's figures were drawn in (seeds follow it), then every catalogue effect
+    // added since: the survey covers the whole catalogue.
+    let mut effects = vec![
         "coulomb_bearing",
         "viscous_quadratic",
         "viscous_linear",
@@ -478,11 +481,14 @@ fn survey_issue_5_every_effect() {
         "accel_gain",
         "speed_drift",
     ];
-    // The whole of effects.md's catalogue (in the order the note's figures were drawn in).
-    let (mut a, mut b) = (effects.to_vec(), pendulum_model::EFFECT_NAMES.to_vec());
-    a.sort_unstable();
-    b.sort_unstable();
-    assert_eq!(a, b);
+    let catalogue = pendulum_model::effects::names();
+    assert!(effects.iter().all(|e| catalogue.contains(e)));
+    let newer: Vec<&str> = catalogue
+        .iter()
+        .copied()
+        .filter(|e| !effects.contains(e))
+        .collect();
+    effects.extend(newer);
     let (mut hits, mut total, mut within) = (0, 0, 0);
     // `SURVEY_ONE=effect:k` re-runs one campaign of the survey (`SURVEY_KEEP=DIR` keeps it).
     let one = std::env::var("SURVEY_ONE").ok();
@@ -962,4 +968,97 @@ fn regression_issue_16_discover_linear_base_names_dry_with_viscous() {
     assert!(dry.ci_low <= c && c <= dry.ci_high, "{dry:?} vs {c}");
     let report = std::fs::read_to_string(s.out_dir.join("report.md")).unwrap();
     assert!(report.contains(pendulum_explain::DECAY_RULE), "{report}");
+}
+
+/// The catalogue's survey designs are the ones the note's figures were drawn with: the same
+/// effects table, base and damping, draw for draw (so the regression seeds still hide what they
+/// did).
+#[test]
+fn catalogue_survey_draws_what_the_hand_written_draw_did() {
+    for effect in pendulum_model::effects::names() {
+        if effect == "stribeck" {
+            continue; // drawn only since the catalogue
+        }
+        for tag in 0..20 {
+            let (t1, s1, b1, a1, bb1, m1) = draw(effect, &mut rng(9000 + tag));
+            let (t2, s2, b2, a2, bb2, m2) = draw_before_the_catalogue(effect, &mut rng(9000 + tag));
+            let parse = |s: &str| toml::from_str::<pendulum_model::Effects>(s).unwrap();
+            assert_eq!(parse(&s1), parse(&s2), "{effect} {tag}");
+            assert_eq!(
+                (t1, b1, a1, bb1, m1),
+                (t2, b2, a2, bb2, m2),
+                "{effect} {tag}"
+            );
+        }
+    }
+}
+
+/// The hand-written draw the catalogue replaced, kept to check the replacement above.
+fn draw_before_the_catalogue(
+    effect: &str,
+    r: &mut rand_chacha::ChaCha8Rng,
+) -> (f64, String, Base, f64, f64, f64) {
+    let sign = |r: &mut rand_chacha::ChaCha8Rng| if r.random::<bool>() { 1.0 } else { -1.0 };
+    match effect {
+        "coulomb_bearing" => {
+            let mu = r.random_range(0.08..0.2);
+            (mu, String::new(), Base::Linear, 0.0, 0.3, mu)
+        }
+        "viscous_quadratic" => {
+            let a = r.random_range(0.05..0.2);
+            (a, String::new(), Base::Linear, a, 0.3, 0.0)
+        }
+        "viscous_linear" => {
+            let b = r.random_range(0.3..0.7);
+            (b, String::new(), Base::Dry, 0.0, b, 0.15)
+        }
+        "bearing_load_base_accel" => {
+            let mu = r.random_range(0.1..0.2);
+            let s = "bearing_load_base_accel = true".to_string();
+            (mu, s, Base::Reference, 0.0, 0.5, mu)
+        }
+        _ => {
+            let (t, s) = match effect {
+                "coulomb_constant" => {
+                    let v = r.random_range(0.006..0.015);
+                    (v, format!("coulomb_constant_t_c_nm = {v}"))
+                }
+                "position_torque" => {
+                    let v = r.random_range(0.015..0.04);
+                    let k = r.random_range(1..=4);
+                    let phi = r.random_range(-3.0..3.0);
+                    (
+                        v,
+                        format!("position_torque = {{ t_p_nm = {v}, k = {k}, phi_p_rad = {phi} }}"),
+                    )
+                }
+                "horizontal_base" => {
+                    let v = r.random_range(0.02..0.08) * sign(r);
+                    (v, format!("horizontal_base_delta_rad = {v}"))
+                }
+                "extra_inertia" => {
+                    let v = r.random_range(0.005..0.02);
+                    (v, format!("extra_inertia_j_kg_m2 = {v}"))
+                }
+                "encoder_offset" => {
+                    let v = r.random_range(0.02..0.08) * sign(r);
+                    (v, format!("encoder_offset_rad = {v}"))
+                }
+                "accel_delay" => {
+                    let v = r.random_range(0.004..0.015);
+                    (v, format!("accel_delay_s = {v}"))
+                }
+                "accel_gain" => {
+                    let v = r.random_range(0.02..0.08) * sign(r);
+                    (v, format!("accel_gain_k_a = {v}"))
+                }
+                "speed_drift" => {
+                    let v = r.random_range(0.0005..0.002) * sign(r);
+                    (v, format!("speed_drift_hz_per_s = {v}"))
+                }
+                other => panic!("no draw for {other}"),
+            };
+            (t, s, Base::Reference, 0.0, 0.5, 0.15)
+        }
+    }
 }

@@ -387,6 +387,11 @@ type Row<'a> = (&'a str, f64, f64, f64);
 
 /// A params.parquet as `pendulum identify` writes it: one row per model.
 fn write_params(path: &Path, rows: &[Row]) {
+    write_params_with(path, rows, &[]);
+}
+
+/// [`write_params`] with extra columns (one value for every row), e.g. an effect's parameter.
+fn write_params_with(path: &Path, rows: &[Row], extra: &[(&str, f64)]) {
     use pendulum_model::Physical;
     use pendulum_report::{Column, ColumnData, TableOptions};
     let rig = Physical::default();
@@ -424,6 +429,9 @@ fn write_params(path: &Path, rows: &[Row]) {
     f("omega_hz", &|_| rig.omega_hz);
     f("f_obj", &|_| 1.0);
     f("e_theta", &|_| 1.0);
+    for (name, v) in extra {
+        f(name, &|_| *v);
+    }
     TableOptions::new().write(path, &cols).unwrap();
 }
 
@@ -834,4 +842,115 @@ fn replay_overlays_simulation_on_the_run() {
     eprintln!("residual RMS over 10 s: {rms10:?}");
     assert!(rms10["reference"] < 0.1, "{rms10:?}");
     assert!(rms10["reference"] < rms10["linear"], "{rms10:?}");
+}
+
+/// Issue 14: `replay` simulates a model the way the fit and discover do (the shared sensor
+/// transform, `Model::measured`): a fitted `accel_delay` shifts the forcing. Replay used to build
+/// its model with `Model::new`, which dropped the delay, so a fitted delay was silently ignored.
+#[test]
+fn issue_14_replay_of_a_model_with_accel_delay_matches_the_fits_simulation() {
+    use pendulum_process::fit::{model_for, FitParam, ModelSpec};
+    let dir = tempfile::tempdir().unwrap();
+    let case = dir.path().join("case.toml");
+    let delay_s = 0.012;
+    // The effects table belongs to [truth]: inserted right after it.
+    let text = CASE.replace(
+        "mu = 0.15\n",
+        &format!("mu = 0.15\n[truth.effects]\naccel_delay_s = {delay_s}\n"),
+    );
+    std::fs::write(&case, text).unwrap();
+    let campaign = dir.path().join("campaign");
+    let mcap_dir = dir.path().join("mcap");
+    for args in [
+        vec![
+            "synth".to_string(),
+            case.display().to_string(),
+            campaign.display().to_string(),
+        ],
+        vec![
+            "ingest".to_string(),
+            campaign.display().to_string(),
+            "--out".to_string(),
+            mcap_dir.display().to_string(),
+            "--quiet".to_string(),
+        ],
+    ] {
+        let o = pendulum().args(&args).output().unwrap();
+        assert!(
+            o.status.success(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+    }
+    let params = dir.path().join("params.parquet");
+    write_params_with(
+        &params,
+        &[("reference", 0.0, 0.5, 0.15)],
+        &[("accel_delay.Delta", delay_s)],
+    );
+    let run_path = mcap_dir.join("r01.mcap");
+    let out = dir.path().join("overlay.mcap");
+    let o = pendulum()
+        .arg("replay")
+        .arg(&run_path)
+        .arg("--params")
+        .arg(&params)
+        .args(["--model", "reference", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let ov = pendulum_log::read_run(&out).unwrap();
+    let meta = &ov.metadata["replay"];
+    let num = |k: &str| -> f64 { meta[k].parse().unwrap() };
+    let (t0, omega_hz) = (num("t0_s"), num("omega_hz"));
+    let y0 = [num("theta0_rad"), num("theta_dot0_rad_s")];
+    let tol = num("tol");
+
+    // The fit's (and discover's) model of the same row on the same run.
+    let log = pendulum_log::read_run(&run_path).unwrap();
+    let rig = pendulum_jobs::runs::run_data_from_log(&log).unwrap().rig;
+    let mut spec = ModelSpec::reference();
+    spec.params.push(FitParam::of("accel_delay"));
+    let phys = spec.physical(&rig, omega_hz, &[0.0, 0.5, 0.15, delay_s]);
+    let w0 = phys.omega0_rad_s();
+    let simulate = |model: &pendulum_model::Model| -> Vec<f64> {
+        let times: Vec<f64> = ov.simulated.iter().map(|s| w0 * (s.t_s - t0)).collect();
+        let mut th = Vec::new();
+        pendulum_model::integrate(
+            model,
+            &pendulum_model::SimOptions::with_tol(tol),
+            0.0,
+            [y0[0], y0[1] / w0],
+            *times.last().unwrap(),
+            times.iter().copied(),
+            |s| {
+                th.push(s.theta);
+                std::ops::ControlFlow::Continue(())
+            },
+        )
+        .unwrap();
+        th
+    };
+    let fit_theta = simulate(&model_for(&phys));
+    let no_delay = simulate(&pendulum_model::Model::new(phys.to_dimensionless()));
+    // Over the first 10 s after t0 (later a chaotic run may amplify rounding).
+    let n = ov.simulated.iter().filter(|s| s.t_s - t0 <= 10.0).count();
+    let max_diff = |th: &[f64]| {
+        ov.simulated[..n]
+            .iter()
+            .zip(th)
+            .map(|(s, t)| (s.theta_rad - t).abs())
+            .fold(0.0, f64::max)
+    };
+    let (d_fit, d_none) = (max_diff(&fit_theta), max_diff(&no_delay));
+    eprintln!(
+        "replay vs fit's model {d_fit:.3e} rad, vs the model without its delay {d_none:.3e} rad"
+    );
+    assert!(
+        d_fit < 1e-9,
+        "replay departs from the fit's simulation by {d_fit} rad"
+    );
+    // The delay matters on this run: dropping it (the old replay) is visibly different.
+    assert!(d_none > 1e-3, "the delay changed nothing ({d_none} rad)");
 }

@@ -28,7 +28,6 @@
 //! `unexplained`, with where it lives.
 
 use pendulum_fit::{Cost, Problem};
-use pendulum_model::PositionTorque;
 use pendulum_process::align::fit_speed_drift;
 use pendulum_process::fit::{FitParam, ModelSpec, PreparedRun, StudyObjective};
 use pendulum_process::identify::{validate, FitOutcome, RunFit, ValidateConfig};
@@ -713,7 +712,7 @@ fn speed_drift_row(
         .flat_map(|r| [r.ic_est[0], r.ic_est[1]])
         .collect();
     let mut spec = base_fit.spec.clone();
-    spec.params.push(FitParam::SpeedDrift);
+    spec.params.push(FitParam::of("speed_drift"));
     spec.name = format!("{}+speed_drift", spec.name);
     let mut x0 = base_fit.params.clone();
     x0.push(est);
@@ -813,27 +812,25 @@ fn extend(
     let (est, _, _) = to_si(c, fit);
     let mut news = Vec::new();
     match c.effect.as_str() {
-        "viscous_linear" => news.push((FitParam::B, est.max(0.0))),
-        "viscous_quadratic" => news.push((FitParam::A, est.max(0.0))),
-        "coulomb_bearing" => news.push((FitParam::Mu, est.max(0.0))),
-        "bearing_load_base_accel" => out.fixed.bearing_load_base_accel = true,
-        "coulomb_constant" => news.push((FitParam::CoulombConstant, est.max(0.0))),
+        // A switch: held on, its bearing friction refitted (already a parameter of the base).
+        "bearing_load_base_accel" => out.fixed.set("bearing_load_base_accel", Some(Vec::new())),
         "position_torque" => {
             let a = fit.coef_of(c.add[0]).map_or(0.0, |x| x.0);
             let b = fit.coef_of(c.add[1]).map_or(0.0, |x| x.0);
-            out.fixed.position_torque = Some(PositionTorque {
-                t_p_nm: 0.0,
-                k: c.k,
-                phi_p_rad: 0.0,
-            });
-            news.push((FitParam::PositionTorque, est));
-            news.push((FitParam::PositionTorquePhase, b.atan2(a)));
+            // k is the candidate's; T_p and φ_p are refitted.
+            out.fixed
+                .set("position_torque", Some(vec![0.0, c.k as f64, 0.0]));
+            news.push((FitParam::of("position_torque"), est));
+            news.push((FitParam::of("position_torque.phi_p"), b.atan2(a)));
         }
-        "horizontal_base" => news.push((FitParam::HorizontalBase, est)),
-        "extra_inertia" => news.push((FitParam::ExtraInertia, est.max(0.0))),
-        "encoder_offset" => news.push((FitParam::EncoderOffset, est)),
-        "accel_delay" => news.push((FitParam::AccelDelay, est)),
-        _ => {}
+        // One refitted parameter, started at the screen's estimate inside its catalogue range's
+        // sign (a non-negative parameter never starts below 0).
+        name => {
+            if let Some(p) = FitParam::find(name) {
+                let lo = p.bounds().0;
+                news.push((p, if lo >= 0.0 { est.max(lo) } else { est }));
+            }
+        }
     }
     for (p, _) in &news {
         if !out.params.contains(p) {

@@ -38,17 +38,6 @@ impl std::fmt::Display for OutputSummary {
     }
 }
 
-const ALL_EFFECT_PARAMS: [FitParam; 8] = [
-    FitParam::AccelDelay,
-    FitParam::SpeedDrift,
-    FitParam::CoulombConstant,
-    FitParam::ExtraInertia,
-    FitParam::HorizontalBase,
-    FitParam::PositionTorque,
-    FitParam::PositionTorquePhase,
-    FitParam::EncoderOffset,
-];
-
 /// Makes OUT ready for a command that writes there, before its long work: creates it, proves it
 /// writable (a probe file created and removed: an unwritable OUT used to fail only after the
 /// fit), and removes this program's stale temporary files from it ([`remove_stale_temps`]).
@@ -337,7 +326,8 @@ pub fn params_columns(ctx: &Context, fits: &[FitOutcome]) -> Vec<Column> {
         push("r_b_m", "m", rig.r_b_m, row);
         push("g_m_s2", "m/s²", rig.g_m_s2, row);
         push("omega_hz", "Hz", omega_hz, row);
-        for p in ALL_EFFECT_PARAMS {
+        // One column per refitted parameter of the catalogue, in its order.
+        for p in FitParam::all_effects() {
             let v = if fit.spec.params.contains(&p) {
                 fit.param(p)
             } else {
@@ -411,7 +401,7 @@ fn free_decay_row(
     push("r_b_m", "m", rig.r_b_m, row);
     push("g_m_s2", "m/s²", rig.g_m_s2, row);
     push("omega_hz", "Hz", nan, row);
-    for p in ALL_EFFECT_PARAMS {
+    for p in FitParam::all_effects() {
         push(p.name(), p.unit(), val(p).unwrap_or(nan), row);
     }
     push("omega0_rad_s", "rad/s", w0, row);
@@ -486,7 +476,8 @@ pub fn read_params(path: &Path, model: Option<&str>) -> Result<FitOutcome, JobEr
                 fixed: Effects::default(),
             };
             let given = |p: FitParam| get(p.name()).is_some_and(|v| !v.is_nan());
-            for p in ALL_EFFECT_PARAMS {
+            // One column per refitted parameter of the catalogue, in its order.
+            for p in FitParam::all_effects() {
                 if given(p) {
                     spec.params.push(p);
                 }
@@ -494,7 +485,7 @@ pub fn read_params(path: &Path, model: Option<&str>) -> Result<FitOutcome, JobEr
             // A free-decay row (it has ω0): the same model in identifiable terms.
             if given(FitParam::Omega0) {
                 if given(FitParam::DryC) {
-                    spec.params.push(FitParam::CoulombConstant);
+                    spec.params.push(FitParam::of("coulomb_constant"));
                 }
                 spec = spec
                     .free_decay()

@@ -17,7 +17,7 @@ use std::path::PathBuf;
 
 use pendulum_log::{read_run, RunLogOptions, SimulatedMsg};
 use pendulum_maps::params_file::load_model;
-use pendulum_model::{integrate, Model, ParamSpec, Physical, SimOptions};
+use pendulum_model::{integrate, Model, ParamSpec, Physical, Sensors, SimOptions};
 use pendulum_process::ic::{estimate_state, IcConfig};
 use pendulum_process::{align, AlignConfig};
 
@@ -149,13 +149,15 @@ pub fn run(a: &ReplayArgs) -> Result<ReplaySummary, JobError> {
     physical.validate()?;
     let params = physical.to_dimensionless();
     params.validate()?;
-    let model = Model::new(params);
-    let offset = physical.effects.encoder_offset_rad.unwrap_or(0.0);
+    // The shared sensor transform, as the fit and discover simulate: an accel_delay shifts the
+    // forcing (`Model::new` alone dropped it), the encoder offset moves the angle.
+    let model = Model::measured(&physical);
+    let sensors = Sensors::of(&physical);
     let w0 = physical.omega0_rad_s();
 
     // Initial state at t0, in the model's frame.
     let ic = estimate_state(&rd, al.t0_s, &IcConfig::default())?;
-    let y0 = [ic.theta_rad - offset, ic.theta_dot_rad_s / w0];
+    let y0 = [sensors.theta_true(ic.theta_rad), ic.theta_dot_rad_s / w0];
 
     // Sample times: the encoder's from t0 on, decimated to --rate-hz if given.
     let enc = &log.encoder;
@@ -246,7 +248,7 @@ pub fn run(a: &ReplayArgs) -> Result<ReplaySummary, JobError> {
     let (mut ss10, mut n10, mut ss, mut n) = (0.0, 0usize, 0.0, 0usize);
     for (&i, s) in idx.iter().zip(&sim) {
         let e = &enc[i];
-        let theta = s[0] + offset;
+        let theta = sensors.theta_measured(s[0]);
         let residual = e.theta_rad - theta;
         w.write_simulated(&SimulatedMsg {
             t_s: e.t_s,

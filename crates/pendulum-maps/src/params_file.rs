@@ -12,7 +12,7 @@ use arrow_array::types::{Float32Type, Float64Type, Int32Type, Int64Type};
 use arrow_array::Array;
 use arrow_array::ArrayRef;
 use parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
-use pendulum_model::spec::{DIMENSIONLESS_KEYS, EFFECT_KEYS, PHYSICAL_KEYS};
+use pendulum_model::spec::{effect_keys, DIMENSIONLESS_KEYS, PHYSICAL_KEYS};
 
 use crate::MapsError;
 
@@ -42,7 +42,7 @@ impl ParamsRow {
             }
         };
         push(&PHYSICAL_KEYS);
-        push(&EFFECT_KEYS);
+        push(&effect_keys());
         if dimensionless {
             push(&DIMENSIONLESS_KEYS);
         }

@@ -1,6 +1,7 @@
 //! The parametric pendulum: parameters, base excitation, the simulator with stick/slip Coulomb
 //! friction, and steady-state classes. Everything downstream (fits, discovery, maps) drives it.
 
+pub mod effects;
 pub mod excitation;
 pub mod params;
 pub mod sim;
@@ -10,8 +11,9 @@ pub mod steady;
 #[cfg(test)]
 mod physics_tests;
 
+pub use effects::{Effect, EffectParam, Sensors, CATALOGUE};
 pub use excitation::{CrankDrive, CrankTable, Excitation, MeasuredAccel};
-pub use params::{Dimensionless, Effects, Physical, PositionTorque, EFFECT_NAMES};
+pub use params::{Dimensionless, Effects, Physical};
 pub use sim::{integrate, simulate, Model, Sample, SimOptions, SimStats, Trajectory};
 pub use spec::ParamSpec;
 pub use steady::{

@@ -12,59 +12,13 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::effects::{Decompiled, CATALOGUE};
 use crate::ModelError;
 
 /// Standard gravity used when a campaign does not state its own, m/s².
 pub const G_STANDARD_M_S2: f64 = 9.81;
 
-/// Effects of `effects.md` beyond the reference model, in SI units. `None`/`false` = absent.
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct Effects {
-    /// `coulomb_constant`: load-independent dry torque T_c, N·m.
-    pub coulomb_constant_t_c_nm: Option<f64>,
-    /// `position_torque`: T_p sin(kθ + φ_p) with amplitude T_p (N·m), integer k ≥ 1, phase φ_p (rad).
-    pub position_torque: Option<PositionTorque>,
-    /// `horizontal_base`: guide tilted δ (rad) from vertical, so x = y·tan δ.
-    pub horizontal_base_delta_rad: Option<f64>,
-    /// `extra_inertia`: rotating inertia J besides the bob, kg·m².
-    pub extra_inertia_j_kg_m2: Option<f64>,
-    /// `bearing_load_base_accel`: the bearing load carries the base acceleration too.
-    pub bearing_load_base_accel: bool,
-    /// `encoder_offset`: measured angle = θ + θ_off, rad (a sensor effect).
-    pub encoder_offset_rad: Option<f64>,
-    /// `accel_delay`: accelerometer samples lag the true motion by Δ, s (a sensor effect).
-    pub accel_delay_s: Option<f64>,
-    /// `accel_gain`: accelerometer sensitivity is (1 + k_a) × nominal (a sensor effect).
-    pub accel_gain_k_a: Option<f64>,
-    /// `speed_drift`: crank speed Ω + (dΩ/dτ)·τ from the moment the shaker is at speed, Hz/s.
-    pub speed_drift_hz_per_s: Option<f64>,
-}
-
-/// `position_torque` parameters.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct PositionTorque {
-    pub t_p_nm: f64,
-    pub k: u32,
-    pub phi_p_rad: f64,
-}
-
-/// The catalogue names of `effects.md`, in its order. Outputs use exactly these strings.
-pub const EFFECT_NAMES: [&str; 12] = [
-    "viscous_linear",
-    "viscous_quadratic",
-    "coulomb_bearing",
-    "bearing_load_base_accel",
-    "coulomb_constant",
-    "position_torque",
-    "horizontal_base",
-    "extra_inertia",
-    "encoder_offset",
-    "accel_delay",
-    "accel_gain",
-    "speed_drift",
-];
+pub use crate::effects::Effects;
 
 /// The rig and the reference model's damping, in SI units (`rig.md`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -167,43 +121,31 @@ impl Physical {
         Ok(())
     }
 
-    /// The study's dimensionless set (Eq. 5–6) plus the dimensionless effect terms.
+    /// The study's dimensionless set (Eq. 5–6) plus the dimensionless effect terms: the drive's
+    /// geometry here, every term (the reference model's a, b, μ included) from its catalogue entry.
     pub fn to_dimensionless(&self) -> Dimensionless {
         let w0 = self.omega0_rad_s();
         let omega = 2.0 * std::f64::consts::PI * self.omega_hz / w0;
-        let scale = self.torque_scale_nm();
-        let e = &self.effects;
-        let (p, k, phi_p) = match e.position_torque {
-            Some(pt) => (pt.t_p_nm / scale, pt.k, pt.phi_p_rad),
-            None => (0.0, 1, 0.0),
-        };
-        Dimensionless {
+        let mut d = Dimensionless {
             omega,
             r: self.crank_r_m * omega * omega / self.l_m,
             lambda: self.crank_r_m / self.rod_l_m,
-            alpha: self.a_kg_m * self.l_m / self.m_kg,
-            beta: self.b_n_s_m / (self.m_kg * w0),
-            m_coulomb: self.mu * self.r_b_m / self.l_m,
-            c: e.coulomb_constant_t_c_nm.unwrap_or(0.0) / scale,
-            p,
-            k,
-            phi_p,
-            tan_delta: e.horizontal_base_delta_rad.unwrap_or(0.0).tan(),
-            j: e.extra_inertia_j_kg_m2.unwrap_or(0.0) / (self.m_kg * self.l_m * self.l_m),
-            base_load: e.bearing_load_base_accel,
-            // dω/dt = 2π (dΩ/dτ) / ω0²: Hz/s → (rad per dimensionless time) per dimensionless time.
-            omega_drift: 2.0 * std::f64::consts::PI * e.speed_drift_hz_per_s.unwrap_or(0.0)
-                / (w0 * w0),
-            kappa: 0.0,
+            ..Dimensionless::conservative()
+        };
+        for e in CATALOGUE {
+            if let Some(v) = e.get(self) {
+                e.compile(&v, self, &mut d);
+            }
         }
+        d
     }
 
     /// Inverse of [`Physical::to_dimensionless`] for the damping and drive: keeps m, l, g, r_b and
-    /// L of `self` and sets Ω, r, a, b, μ and the effects so that they map to `d`.
+    /// L of `self` and sets Ω, r, a, b, μ and the effects so that they map to `d` (sensor effects,
+    /// which `d` does not carry, are kept).
     pub fn with_dimensionless(&self, d: &Dimensionless) -> Physical {
         let mut p = self.clone();
         let w0 = self.omega0_rad_s();
-        let scale = self.torque_scale_nm();
         p.omega_hz = d.omega * w0 / (2.0 * std::f64::consts::PI);
         p.crank_r_m = if d.omega > 0.0 {
             d.r * self.l_m / (d.omega * d.omega)
@@ -215,21 +157,12 @@ impl Physical {
         } else {
             self.rod_l_m
         };
-        p.a_kg_m = d.alpha * self.m_kg / self.l_m;
-        p.b_n_s_m = d.beta * self.m_kg * w0;
-        p.mu = d.m_coulomb * self.l_m / self.r_b_m;
-        let e = &mut p.effects;
-        e.coulomb_constant_t_c_nm = (d.c != 0.0).then_some(d.c * scale);
-        e.position_torque = (d.p != 0.0).then_some(PositionTorque {
-            t_p_nm: d.p * scale,
-            k: d.k,
-            phi_p_rad: d.phi_p,
-        });
-        e.horizontal_base_delta_rad = (d.tan_delta != 0.0).then_some(d.tan_delta.atan());
-        e.extra_inertia_j_kg_m2 = (d.j != 0.0).then_some(d.j * self.m_kg * self.l_m * self.l_m);
-        e.bearing_load_base_accel = d.base_load;
-        e.speed_drift_hz_per_s = (d.omega_drift != 0.0)
-            .then_some(d.omega_drift * w0 * w0 / (2.0 * std::f64::consts::PI));
+        for e in CATALOGUE {
+            // Scales from `self`: m, l, g and r_b are the same, Ω and r are not used by any term.
+            if let Decompiled::Set(v) = e.decompile(d, self) {
+                e.set(&mut p, v.as_deref());
+            }
+        }
         p
     }
 }
@@ -266,6 +199,12 @@ pub struct Dimensionless {
     pub base_load: bool,
     /// Crank speed drift dω/dt in dimensionless units.
     pub omega_drift: f64,
+    /// Dry torque fading with speed, s·e^{−(θ̇/v)²} sgn θ̇, held in full at rest: its size
+    /// s (a torque per m g l) and speed scale v (dimensionless, > 0 when s ≠ 0). Absent = 0.
+    #[serde(default)]
+    pub s_break: f64,
+    #[serde(default)]
+    pub v_break: f64,
     /// Linear restoring stiffness κ = k/(m g l) of a torque −k θ besides gravity (a torsion
     /// spring, a cable): free decays of spring-loaded pendulums (issue 16). Absent = 0.
     #[serde(default)]
@@ -296,6 +235,8 @@ impl Dimensionless {
             j: 0.0,
             base_load: false,
             omega_drift: 0.0,
+            s_break: 0.0,
+            v_break: 0.0,
             kappa: 0.0,
         }
     }
@@ -321,6 +262,12 @@ impl Dimensionless {
             ("c", self.c, self.c >= 0.0),
             ("j", self.j, self.j > -1.0),
             ("kappa", self.kappa, self.kappa >= 0.0),
+            ("s_break", self.s_break, self.s_break >= 0.0),
+            (
+                "v_break",
+                self.v_break,
+                self.v_break >= 0.0 && (self.s_break == 0.0 || self.v_break > 0.0),
+            ),
         ];
         for (name, v, ok) in checks {
             if !(v.is_finite() && ok) {
@@ -330,6 +277,7 @@ impl Dimensionless {
                     expected: match name {
                         "lambda" => "0 ≤ λ < 1".into(),
                         "j" => "j > −1".into(),
+                        "v_break" => "v > 0 when s > 0".into(),
                         _ => "a finite value ≥ 0".into(),
                     },
                 });
@@ -415,15 +363,12 @@ mod tests {
             a_kg_m: 0.01,
             ..Physical::default()
         };
-        p.effects.coulomb_constant_t_c_nm = Some(0.004);
-        p.effects.position_torque = Some(PositionTorque {
-            t_p_nm: 0.01,
-            k: 3,
-            phi_p_rad: 0.2,
-        });
-        p.effects.horizontal_base_delta_rad = Some(0.03);
-        p.effects.extra_inertia_j_kg_m2 = Some(0.002);
-        p.effects.speed_drift_hz_per_s = Some(-0.001);
+        p.effects.set("coulomb_constant", Some(vec![0.004]));
+        p.effects.set("position_torque", Some(vec![0.01, 3.0, 0.2]));
+        p.effects.set("horizontal_base", Some(vec![0.03]));
+        p.effects.set("extra_inertia", Some(vec![0.002]));
+        p.effects.set("speed_drift", Some(vec![-0.001]));
+        p.effects.set("encoder_offset", Some(vec![0.05]));
         let d = p.to_dimensionless();
         let back = p.with_dimensionless(&d);
         for (a, b) in [
@@ -433,14 +378,27 @@ mod tests {
             (back.a_kg_m, p.a_kg_m),
             (back.b_n_s_m, p.b_n_s_m),
             (back.mu, p.mu),
-            (back.effects.coulomb_constant_t_c_nm.unwrap(), 0.004),
-            (back.effects.position_torque.unwrap().t_p_nm, 0.01),
-            (back.effects.horizontal_base_delta_rad.unwrap(), 0.03),
-            (back.effects.extra_inertia_j_kg_m2.unwrap(), 0.002),
-            (back.effects.speed_drift_hz_per_s.unwrap(), -0.001),
+            (back.effects.value("coulomb_constant.T_c").unwrap(), 0.004),
+            (back.effects.value("position_torque.T_p").unwrap(), 0.01),
+            (back.effects.value("position_torque.k").unwrap(), 3.0),
+            (back.effects.value("position_torque.phi_p").unwrap(), 0.2),
+            (back.effects.value("horizontal_base.delta").unwrap(), 0.03),
+            (back.effects.value("extra_inertia.J").unwrap(), 0.002),
+            (
+                back.effects.value("speed_drift.dOmega_dtau").unwrap(),
+                -0.001,
+            ),
+            // A sensor effect: not in the dimensionless set, kept.
+            (
+                back.effects.value("encoder_offset.theta_off").unwrap(),
+                0.05,
+            ),
         ] {
             assert!(close(a, b, 1e-12), "{a} vs {b}");
         }
+        // Every effect the physical set holds comes back, and no other.
+        let names = |p: &Physical| p.effects.iter().map(|(e, _)| e.name()).collect::<Vec<_>>();
+        assert_eq!(names(&back), names(&p));
     }
 
     #[test]

@@ -293,3 +293,132 @@ fn forced_stick_slip_respects_the_friction_cone() {
     assert!(stuck_samples > 10, "never stuck");
     assert!(slipping_after_stick, "never broke loose");
 }
+
+/// Dry friction with breakaway, c + s·e^{−(θ̇/v)²} (stribeck's shape), β = 0: the work–energy law
+/// fixes each turning point. With u = θ̇²/2 as a function of θ over a half swing from rest at −A,
+/// du/dθ = −sin θ − c − s·e^{−2u/v²}: integrated here in θ, by RK4 at a fine step (another
+/// variable, another integrator), to the next rest point B, where u = 0 again. The pendulum must
+/// reach the same B, and stick there exactly when |sin B| ≤ c + s (the breakaway torque holds in
+/// full at rest), not merely when |sin B| ≤ c.
+#[test]
+fn breakaway_decay_follows_work_energy_law() {
+    let (c, s, v) = (0.004, 0.012, 0.15);
+    let mut d = Dimensionless::conservative();
+    d.c = c;
+    d.s_break = s;
+    d.v_break = v;
+    let m = Model::with_excitation(d, Excitation::None);
+    // du/dθ while slipping towards +θ, and the next rest point from rest at −a.
+    let f = |th: f64, u: f64| -> f64 { -th.sin() - c - s * (-2.0 * u.max(0.0) / (v * v)).exp() };
+    let rk4 = |th: f64, u: f64, h: f64| -> f64 {
+        let k1 = f(th, u);
+        let k2 = f(th + 0.5 * h, u + 0.5 * h * k1);
+        let k3 = f(th + 0.5 * h, u + 0.5 * h * k2);
+        let k4 = f(th + h, u + h * k3);
+        u + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+    };
+    let next_rest = |a: f64| -> f64 {
+        let h = 2e-5;
+        let (mut th, mut u) = (-a, 0.0);
+        loop {
+            let u1 = rk4(th, u, h);
+            if u1 <= 0.0 && th > -a + h {
+                // u crosses 0 inside this step: secant on the step length.
+                let (mut h0, mut g0, mut h1, mut g1) = (0.0, u, h, u1);
+                for _ in 0..40 {
+                    if g1 == g0 {
+                        break;
+                    }
+                    let h2 = h1 - g1 * (h1 - h0) / (g1 - g0);
+                    (h0, g0) = (h1, g1);
+                    h1 = h2;
+                    g1 = rk4(th, u, h1);
+                }
+                return th + h1;
+            }
+            th += h;
+            u = u1;
+        }
+    };
+    let a0: f64 = 0.9;
+    let mut expected: Vec<f64> = vec![a0];
+    loop {
+        let a = *expected.last().unwrap();
+        // Rest at ±a: it breaks loose only if gravity beats the full static capacity c + s.
+        if a.sin().abs() <= c + s {
+            break;
+        }
+        expected.push(next_rest(a));
+    }
+    assert!(expected.len() > 10, "{expected:?}");
+    // The last rest point holds only thanks to s (else the test would not show it).
+    let last = *expected.last().unwrap();
+    assert!(last.sin() > c, "last rest {last} would hold with c alone");
+
+    let tr = simulate(
+        &m,
+        &SimOptions::with_tol(1e-11),
+        [-a0, 0.0],
+        0.0,
+        600.0,
+        0.002,
+    )
+    .unwrap();
+    let mut got = vec![a0];
+    got.extend(turning_points(&tr.theta, &tr.theta_dot));
+    // The final rest point is reached stuck (θ̇ = 0 exactly), not as a turning point.
+    let rest = tr.theta.last().unwrap().abs();
+    assert!(tr.stats.ended_stuck);
+    assert_eq!(*tr.theta_dot.last().unwrap(), 0.0);
+    got.push(rest);
+    got.dedup_by(|x, y| (*x - *y).abs() < 1e-9);
+    assert_eq!(got.len(), expected.len(), "{got:?} vs {expected:?}");
+    for (g, e) in got.iter().zip(&expected) {
+        assert!((g - e).abs() < 2e-7, "turning point {g} vs work–energy {e}");
+    }
+}
+
+/// Stick/slip under forcing with a breakaway torque: while stuck the static balance holds with
+/// the full capacity (M·N + c + s), and the pendulum breaks loose again.
+#[test]
+fn forced_stick_slip_with_breakaway_respects_the_friction_cone() {
+    let mut d = Dimensionless::conservative();
+    d.omega = 1.0;
+    d.r = 0.6;
+    d.lambda = 0.126;
+    d.m_coulomb = 0.03;
+    d.s_break = 0.03;
+    d.v_break = 0.1;
+    d.beta = 0.05;
+    let m = Model::new(d);
+    let (mut stuck, mut broke_loose, mut prev) = (0, false, false);
+    integrate(
+        &m,
+        &SimOptions::default(),
+        0.0,
+        [0.3, 0.0],
+        200.0,
+        uniform_times(0.0, 200.0, 0.01),
+        |smp| {
+            if smp.theta_dot == 0.0 && smp.t > 0.0 {
+                stuck += 1;
+                let (q, cap) = m.static_balance(smp.t, smp.theta);
+                assert!(
+                    q.abs() <= cap + 1e-9,
+                    "stuck outside the cone at t={}",
+                    smp.t
+                );
+                prev = true;
+            } else {
+                broke_loose |= prev;
+                prev = false;
+            }
+            ControlFlow::Continue(())
+        },
+    )
+    .unwrap();
+    assert!(
+        stuck > 10 && broke_loose,
+        "stuck {stuck}, broke loose {broke_loose}"
+    );
+}

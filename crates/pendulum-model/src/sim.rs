@@ -5,10 +5,11 @@
 //! generic solver overhead dominates (`notes/crates.md`: 170–190 ns/step for a crate's DOPRI5 vs
 //! ~45 ns for a hand RK4 step). The stick/slip logic also needs to own the step loop.
 //!
-//! Hybrid system: while slipping in direction d = ±1 the friction term is (M·N + c)·d, a smooth
-//! right-hand side; the event θ̇ = 0 is located on the dense output. At the event the applied
-//! torque Q (everything but friction, at θ̇ = 0) is compared with the static capacity C = M·N + c:
-//! |Q| ≤ C → stick (θ̇ = 0 exactly, θ fixed) until |Q(t)| > C(t); otherwise slip in direction sgn Q.
+//! Hybrid system: while slipping in direction d = ±1 the friction term is
+//! (M·N + c + s·e^{−(θ̇/v)²})·d, a smooth right-hand side; the event θ̇ = 0 is located on the dense
+//! output. At the event the applied torque Q (everything but friction, at θ̇ = 0) is compared with
+//! the static capacity C = M·N + c + s: |Q| ≤ C → stick (θ̇ = 0 exactly, θ fixed) until
+//! |Q(t)| > C(t); otherwise slip in direction sgn Q.
 
 use std::ops::ControlFlow;
 use std::sync::Arc;
@@ -37,6 +38,19 @@ impl Model {
             params,
             crank_table: None,
         }
+    }
+
+    /// The model of `phys` in the clock its captures are aligned on (t = 0 at the accelerometer's
+    /// peak), through the shared sensor transform ([`crate::Sensors`]): with `accel_delay` the
+    /// accelerometer lags, so the true forcing leads that clock by Δ. Fit, discover and replay
+    /// all build their models here ([`Model::new`] alone would drop the delay).
+    pub fn measured(phys: &crate::Physical) -> Self {
+        let d = phys.to_dimensionless();
+        let mut m = Model::new(d);
+        if let Excitation::Crank(c) = &mut m.excitation {
+            c.phi0 = crate::Sensors::of(phys).forcing_lead_rad(d.omega, phys.omega0_rad_s());
+        }
+        m
     }
 
     /// Same parameters, another excitation.
@@ -69,7 +83,7 @@ impl Model {
     }
 
     fn has_dry_friction(&self) -> bool {
-        self.params.m_coulomb > 0.0 || self.params.c > 0.0
+        self.params.m_coulomb > 0.0 || self.params.c > 0.0 || self.params.s_break > 0.0
     }
 
     /// Non-friction torque at rest, Q, and the static friction capacity C, at (t, θ).
@@ -88,7 +102,8 @@ impl Model {
         } else {
             c.abs()
         };
-        (q, p.m_coulomb * load + p.c)
+        // At rest the fading dry torque holds with its full size s.
+        (q, p.m_coulomb * load + p.c + p.s_break)
     }
 
     /// θ̈ while slipping in direction `dir` (±1; 0 when there is no dry friction).
@@ -106,7 +121,13 @@ impl Model {
             } else {
                 (w2 + c).abs()
             };
-            q -= (p.m_coulomb * load + p.c) * dir;
+            let mut dry = p.m_coulomb * load + p.c;
+            // Tested, not multiplied by zero: the exp is the costliest term, and most models lack it.
+            if p.s_break != 0.0 {
+                let x = theta_dot / p.v_break;
+                dry += p.s_break * (-x * x).exp();
+            }
+            q -= dry * dir;
         }
         if p.p != 0.0 {
             q -= p.p * (p.k as f64 * theta + p.phi_p).sin();

@@ -6,7 +6,7 @@
 //! `alpha`, `beta`, `M`) replace the derived values. Effect parameters are SI (effects.md) and are
 //! made dimensionless with the resolved m, l and g.
 
-use crate::{Dimensionless, ModelError, Physical, PositionTorque};
+use crate::{Dimensionless, ModelError, Physical};
 
 /// Physical keys, by their `rig.md`/`effects.md` names.
 pub const PHYSICAL_KEYS: [&str; 10] = [
@@ -23,21 +23,16 @@ pub const PHYSICAL_KEYS: [&str; 10] = [
 ];
 /// Dimensionless keys, the study's Eq. 5–6 names.
 pub const DIMENSIONLESS_KEYS: [&str; 6] = ["omega", "R", "lambda", "alpha", "beta", "M"];
-/// Effect keys, `effect.parameter` with effects.md's symbols.
-pub const EFFECT_KEYS: [&str; 12] = [
-    "coulomb_constant.T_c",
-    "position_torque.T_p",
-    "position_torque.k",
-    "position_torque.phi_p",
-    "horizontal_base.delta",
-    "extra_inertia.J",
-    "bearing_load_base_accel.on",
-    "encoder_offset.theta_off",
-    "accel_delay.Delta",
-    "accel_gain.k_a",
-    "speed_drift.dOmega_dtau",
-    "viscous_quadratic.a",
-];
+/// Older spelling of a key, kept readable: (alias, key).
+const ALIASES: [(&str, &str); 1] = [("viscous_quadratic.a", "a")];
+
+/// Effect keys, `effect.parameter` with effects.md's symbols, from the catalogue (plus the
+/// older `viscous_quadratic.a` for `a`).
+pub fn effect_keys() -> Vec<&'static str> {
+    let mut keys = crate::effects::param_keys();
+    keys.extend(ALIASES.iter().map(|(alias, _)| *alias));
+    keys
+}
 
 /// A list of `key=value` assignments, resolved into parameters.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -61,7 +56,7 @@ impl ParamSpec {
             let k = k.trim();
             if !PHYSICAL_KEYS.contains(&k)
                 && !DIMENSIONLESS_KEYS.contains(&k)
-                && !EFFECT_KEYS.contains(&k)
+                && !effect_keys().contains(&k)
             {
                 return Err(ModelError::UnknownParam {
                     key: k.to_string(),
@@ -69,7 +64,7 @@ impl ParamSpec {
                         "{}, {} or {}",
                         DIMENSIONLESS_KEYS.join(", "),
                         PHYSICAL_KEYS.join(", "),
-                        EFFECT_KEYS.join(", ")
+                        effect_keys().join(", ")
                     ),
                 });
             }
@@ -98,13 +93,16 @@ impl ParamSpec {
             .map(|(_, v)| *v)
     }
 
-    /// Resolves onto `base` (see the module docs). Returns the physical set (with the
-    /// dimensionless overrides mapped back) and the dimensionless set.
-    pub fn resolve(&self, base: &Physical) -> Result<(Physical, Dimensionless), ModelError> {
-        let mut p = base.clone();
+    /// Applies the physical and effect keys to `p` in order (no validation, no dimensionless
+    /// keys): the survey's designs are built with it.
+    pub fn apply_physical(&self, p: &mut Physical) -> Result<(), ModelError> {
         for (k, v) in &self.assignments {
             let v = *v;
-            match k.as_str() {
+            let k = ALIASES
+                .iter()
+                .find(|(alias, _)| alias == k)
+                .map_or(k.as_str(), |(_, key)| *key);
+            match k {
                 "m_kg" => p.m_kg = v,
                 "l_m" => p.l_m = v,
                 "crank_r_m" => p.crank_r_m = v,
@@ -112,42 +110,23 @@ impl ParamSpec {
                 "r_b_m" => p.r_b_m = v,
                 "omega_hz" => p.omega_hz = v,
                 "g_m_s2" => p.g_m_s2 = v,
-                "a" | "viscous_quadratic.a" => p.a_kg_m = v,
+                "a" => p.a_kg_m = v,
                 "b" => p.b_n_s_m = v,
                 "mu" => p.mu = v,
-                "coulomb_constant.T_c" => p.effects.coulomb_constant_t_c_nm = Some(v),
-                "position_torque.T_p" | "position_torque.k" | "position_torque.phi_p" => {
-                    let mut pt = p.effects.position_torque.unwrap_or(PositionTorque {
-                        t_p_nm: 0.0,
-                        k: 1,
-                        phi_p_rad: 0.0,
-                    });
-                    match k.as_str() {
-                        "position_torque.T_p" => pt.t_p_nm = v,
-                        "position_torque.k" => {
-                            if v < 1.0 || v.fract() != 0.0 {
-                                return Err(ModelError::BadParamValue {
-                                    key: k.clone(),
-                                    value: v.to_string(),
-                                    expected: "an integer ≥ 1".into(),
-                                });
-                            }
-                            pt.k = v as u32
-                        }
-                        _ => pt.phi_p_rad = v,
-                    }
-                    p.effects.position_torque = Some(pt);
+                // Effect keys; dimensionless keys are applied by `resolve`.
+                _ => {
+                    crate::effects::apply_key(p, k, v)?;
                 }
-                "horizontal_base.delta" => p.effects.horizontal_base_delta_rad = Some(v),
-                "extra_inertia.J" => p.effects.extra_inertia_j_kg_m2 = Some(v),
-                "bearing_load_base_accel.on" => p.effects.bearing_load_base_accel = v != 0.0,
-                "encoder_offset.theta_off" => p.effects.encoder_offset_rad = Some(v),
-                "accel_delay.Delta" => p.effects.accel_delay_s = Some(v),
-                "accel_gain.k_a" => p.effects.accel_gain_k_a = Some(v),
-                "speed_drift.dOmega_dtau" => p.effects.speed_drift_hz_per_s = Some(v),
-                _ => {} // dimensionless keys: below
             }
         }
+        Ok(())
+    }
+
+    /// Resolves onto `base` (see the module docs). Returns the physical set (with the
+    /// dimensionless overrides mapped back) and the dimensionless set.
+    pub fn resolve(&self, base: &Physical) -> Result<(Physical, Dimensionless), ModelError> {
+        let mut p = base.clone();
+        self.apply_physical(&mut p)?;
         p.validate()?;
         let mut d = p.to_dimensionless();
         if let Some(v) = self.get("omega") {

@@ -26,39 +26,25 @@ use std::sync::OnceLock;
 
 use pendulum_fit::{Cost, Problem};
 use pendulum_model::{
-    classify_poincare, integrate, ClassifyOptions, Effects, Model, PartialClass, Physical,
-    SimOptions, SteadyClass, SteadyState,
+    classify_poincare, integrate, ClassifyOptions, EffectParam, Effects, Model, PartialClass,
+    Physical, SimOptions, SteadyClass, SteadyState,
 };
 use serde::{Deserialize, Serialize};
 
 use crate::run::{RigParams, Role};
 
-/// A parameter a model can fit, with its SI unit and the study's (or a plausible) search range.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
+/// A parameter a model can fit. The SI ones are the catalogue's (`pendulum_model::effects`):
+/// their name, unit, search range and how they enter the model come from the effect's entry.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum FitParam {
-    /// Quadratic drag a, kg/m.
+    /// Quadratic drag a, kg/m (`viscous_quadratic`).
     A,
-    /// Linear drag b, N·s/m.
+    /// Linear drag b, N·s/m (`viscous_linear`).
     B,
-    /// Bearing friction μ.
+    /// Bearing friction μ (`coulomb_bearing`).
     Mu,
-    /// `coulomb_constant` T_c, N·m.
-    CoulombConstant,
-    /// `extra_inertia` J, kg·m².
-    ExtraInertia,
-    /// `horizontal_base` δ, rad.
-    HorizontalBase,
-    /// `position_torque` T_p (k = 1, φ_p fitted separately), N·m.
-    PositionTorque,
-    /// `position_torque` φ_p, rad.
-    PositionTorquePhase,
-    /// `encoder_offset` θ_off, rad.
-    EncoderOffset,
-    /// `accel_delay` Δ, s: the forcing leads the accelerometer-aligned clock by Δ.
-    AccelDelay,
-    /// `speed_drift` dΩ/dτ, Hz/s.
-    SpeedDrift,
+    /// Any other refitted parameter of the catalogue, e.g. `coulomb_constant.T_c`.
+    Effect(EffectParam),
     /// Free decay: small-swing natural frequency ω0, rad/s (the unit of dimensionless time).
     Omega0,
     /// Free decay: β = viscous torque/(I ω0 θ̇) (`viscous_linear` per unit inertia).
@@ -71,114 +57,157 @@ pub enum FitParam {
     DryC,
 }
 
+/// A free-decay parameter: (it, spec name, column name, unit, bounds).
+type FreeDecayParam = (
+    FitParam,
+    &'static str,
+    &'static str,
+    &'static str,
+    (f64, f64),
+);
+
+/// Free-decay parameters (identifiable ratios: not the catalogue's SI ones).
+const FREE_DECAY: [FreeDecayParam; 5] = [
+    // ω0's bounds are relative to the run's estimate.
+    (
+        FitParam::Omega0,
+        "omega0",
+        "omega0_rad_s",
+        "rad/s",
+        (0.95, 1.05),
+    ),
+    (FitParam::Beta, "beta", "beta", "1", (0.0, 0.2)),
+    (FitParam::Alpha, "alpha", "alpha", "1/rad", (0.0, 0.5)),
+    (FitParam::MBearing, "m_bearing", "M", "1", (0.0, 0.05)),
+    (FitParam::DryC, "dry_c", "c", "rad", (0.0, 0.05)),
+];
+
 impl FitParam {
+    /// The parameter a spec or the code names: `a`, `b`, `mu`, an effect's key
+    /// (`position_torque.phi_p`) or an effect's name (its first refitted parameter:
+    /// `coulomb_constant`), or a free-decay ratio (`beta`, `dry_c`, …).
+    pub fn find(name: &str) -> Option<Self> {
+        if let Some(f) = FREE_DECAY.iter().find(|f| f.1 == name) {
+            return Some(f.0);
+        }
+        // Written by the enum this replaced.
+        let name = if name == "position_torque_phase" {
+            "position_torque.phi_p"
+        } else {
+            name
+        };
+        let ep = EffectParam::find(name)?;
+        Some(Self::from_effect(ep))
+    }
+
+    /// Like [`FitParam::find`], for names in the code (panics on a name the catalogue lacks).
+    pub fn of(name: &str) -> Self {
+        Self::find(name).unwrap_or_else(|| panic!("no fit parameter {name:?}"))
+    }
+
+    fn from_effect(ep: EffectParam) -> Self {
+        match ep.def().key {
+            "a" => FitParam::A,
+            "b" => FitParam::B,
+            "mu" => FitParam::Mu,
+            _ => FitParam::Effect(ep),
+        }
+    }
+
+    /// The catalogue parameter, for the SI ones.
+    pub fn effect_param(self) -> Option<EffectParam> {
+        match self {
+            FitParam::A => Some(EffectParam::of("a")),
+            FitParam::B => Some(EffectParam::of("b")),
+            FitParam::Mu => Some(EffectParam::of("mu")),
+            FitParam::Effect(ep) => Some(ep),
+            _ => None,
+        }
+    }
+
+    /// The catalogue effect it belongs to (`None` for the free-decay ratios).
+    pub fn effect_name(self) -> Option<&'static str> {
+        self.effect_param().map(|ep| ep.effect().name())
+    }
+
+    /// Every refitted SI parameter of the catalogue beyond a, b, μ (the outputs' columns).
+    pub fn all_effects() -> Vec<FitParam> {
+        EffectParam::all_fitted()
+            .into_iter()
+            .map(Self::from_effect)
+            .filter(|p| matches!(p, FitParam::Effect(_)))
+            .collect()
+    }
+
+    fn free(self) -> Option<&'static FreeDecayParam> {
+        FREE_DECAY.iter().find(|f| f.0 == self)
+    }
+
     /// Column name in the outputs.
     pub fn name(self) -> &'static str {
-        match self {
-            FitParam::A => "a",
-            FitParam::B => "b",
-            FitParam::Mu => "mu",
-            FitParam::CoulombConstant => "coulomb_constant.T_c",
-            FitParam::ExtraInertia => "extra_inertia.J",
-            FitParam::HorizontalBase => "horizontal_base.delta",
-            FitParam::PositionTorque => "position_torque.T_p",
-            FitParam::PositionTorquePhase => "position_torque.phi_p",
-            FitParam::EncoderOffset => "encoder_offset.theta_off",
-            FitParam::AccelDelay => "accel_delay.Delta",
-            FitParam::SpeedDrift => "speed_drift.dOmega_dtau",
-            FitParam::Omega0 => "omega0_rad_s",
-            FitParam::Beta => "beta",
-            FitParam::Alpha => "alpha",
-            FitParam::MBearing => "M",
-            FitParam::DryC => "c",
+        match self.effect_param() {
+            Some(ep) => ep.def().key,
+            None => self.free().expect("a free-decay parameter").2,
         }
     }
 
     pub fn unit(self) -> &'static str {
-        match self {
-            FitParam::A => "kg/m",
-            FitParam::B => "N·s/m",
-            FitParam::Mu => "1",
-            FitParam::CoulombConstant | FitParam::PositionTorque => "N·m",
-            FitParam::ExtraInertia => "kg·m²",
-            FitParam::HorizontalBase | FitParam::PositionTorquePhase | FitParam::EncoderOffset => {
-                "rad"
-            }
-            FitParam::AccelDelay => "s",
-            FitParam::SpeedDrift => "Hz/s",
-            FitParam::Omega0 => "rad/s",
-            FitParam::Beta | FitParam::MBearing => "1",
-            FitParam::Alpha => "1/rad",
-            FitParam::DryC => "rad",
+        match self.effect_param() {
+            Some(ep) => ep.def().unit,
+            None => self.free().expect("a free-decay parameter").3,
         }
     }
 
-    /// Search bounds: the study's for a, b, μ (0 < a < 1, 0 < b < 1, 0 < μ < 0.25).
+    /// Search bounds: the catalogue's (the study's for a, b, μ: 0 < a < 1, 0 < b < 1,
+    /// 0 < μ < 0.25).
     pub fn bounds(self) -> (f64, f64) {
-        match self {
-            FitParam::A => (0.0, 1.0),
-            FitParam::B => (0.0, 1.0),
-            FitParam::Mu => (0.0, 0.25),
-            FitParam::CoulombConstant => (0.0, 0.05),
-            FitParam::ExtraInertia => (0.0, 0.02),
-            FitParam::HorizontalBase => (-0.2, 0.2),
-            FitParam::PositionTorque => (0.0, 0.1),
-            FitParam::PositionTorquePhase => (-std::f64::consts::PI, std::f64::consts::PI),
-            FitParam::EncoderOffset => (-0.2, 0.2),
-            FitParam::AccelDelay => (-0.05, 0.05),
-            FitParam::SpeedDrift => (-0.01, 0.01),
-            // Relative to the period-derived estimate: the objective scales it (see `bounds`).
-            FitParam::Omega0 => (0.95, 1.05),
-            FitParam::Beta => (0.0, 0.2),
-            FitParam::Alpha => (0.0, 0.5),
-            FitParam::MBearing | FitParam::DryC => (0.0, 0.05),
+        match self.effect_param() {
+            Some(ep) => ep
+                .def()
+                .fit_range
+                .unwrap_or_else(|| panic!("{} is not refitted", ep.def().key)),
+            None => self.free().expect("a free-decay parameter").4,
         }
     }
 
     fn apply(self, v: f64, p: &mut Physical) {
-        let e = &mut p.effects;
-        match self {
-            FitParam::A => p.a_kg_m = v,
-            FitParam::B => p.b_n_s_m = v,
-            FitParam::Mu => p.mu = v,
-            FitParam::CoulombConstant => e.coulomb_constant_t_c_nm = Some(v),
-            FitParam::ExtraInertia => e.extra_inertia_j_kg_m2 = Some(v),
-            FitParam::HorizontalBase => e.horizontal_base_delta_rad = Some(v),
-            FitParam::PositionTorque | FitParam::PositionTorquePhase => {
-                let mut pt = e.position_torque.unwrap_or(pendulum_model::PositionTorque {
-                    t_p_nm: 0.0,
-                    k: 1,
-                    phi_p_rad: 0.0,
-                });
-                if self == FitParam::PositionTorque {
-                    pt.t_p_nm = v;
-                } else {
-                    pt.phi_p_rad = v;
-                }
-                e.position_torque = Some(pt);
-            }
-            FitParam::EncoderOffset => e.encoder_offset_rad = Some(v),
-            FitParam::AccelDelay => e.accel_delay_s = Some(v),
-            FitParam::SpeedDrift => e.speed_drift_hz_per_s = Some(v),
-            // Identifiable ratios of a free decay: no SI counterpart without m, l and J.
-            FitParam::Omega0
-            | FitParam::Beta
-            | FitParam::Alpha
-            | FitParam::MBearing
-            | FitParam::DryC => {}
+        // Identifiable ratios of a free decay have no SI counterpart without m, l and J.
+        if let Some(ep) = self.effect_param() {
+            ep.apply(v, p);
         }
     }
 
     /// Free-decay parameters (identifiable ratios, excitation off).
     pub fn is_free_decay(self) -> bool {
-        matches!(
-            self,
-            FitParam::Omega0
-                | FitParam::Beta
-                | FitParam::Alpha
-                | FitParam::MBearing
-                | FitParam::DryC
-        )
+        self.free().is_some()
+    }
+
+    /// The name a spec is written with (what [`FitParam::find`] reads back).
+    pub fn spec_name(self) -> &'static str {
+        match self.effect_param() {
+            Some(ep) => ep.spec_name(),
+            None => self.free().expect("a free-decay parameter").1,
+        }
+    }
+}
+
+impl Serialize for FitParam {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(self.spec_name())
+    }
+}
+
+impl<'de> Deserialize<'de> for FitParam {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let name = String::deserialize(d)?;
+        FitParam::find(&name).ok_or_else(|| {
+            let mut known: Vec<&str> = vec!["a", "b", "mu"];
+            known.extend(FitParam::all_effects().iter().map(|p| p.spec_name()));
+            serde::de::Error::custom(format!(
+                "unknown fit parameter {name:?}: expected one of {}",
+                known.join(", ")
+            ))
+        })
     }
 }
 
@@ -241,13 +270,13 @@ impl ModelSpec {
         }
         let mut params = vec![FitParam::Omega0];
         for p in &self.params {
-            let q = match p {
-                FitParam::A => FitParam::Alpha,
-                FitParam::B => FitParam::Beta,
-                FitParam::Mu => FitParam::MBearing,
-                FitParam::CoulombConstant => FitParam::DryC,
-                FitParam::EncoderOffset => FitParam::EncoderOffset,
-                other => {
+            let q = match (p, p.effect_name()) {
+                (FitParam::A, _) => FitParam::Alpha,
+                (FitParam::B, _) => FitParam::Beta,
+                (FitParam::Mu, _) => FitParam::MBearing,
+                (_, Some("coulomb_constant")) => FitParam::DryC,
+                (_, Some("encoder_offset")) => *p,
+                (other, _) => {
                     return Err(format!(
                     "{} cannot be fitted to a free decay (no shaker; inertia absorbed in omega0)",
                     other.name()
@@ -258,8 +287,9 @@ impl ModelSpec {
                 params.push(q);
             }
         }
-        if !params.contains(&FitParam::EncoderOffset) {
-            params.push(FitParam::EncoderOffset);
+        let offset = FitParam::of("encoder_offset");
+        if !params.contains(&offset) {
+            params.push(offset);
         }
         Ok(ModelSpec {
             name: self.name.clone(),
@@ -302,8 +332,8 @@ impl ModelSpec {
         if run.free {
             self.free_model(x)
         } else {
-            // model_for: an accel_delay shifts the forcing's phase (Model::new alone would drop it).
-            model_for(&self.physical(&run.rig, run.omega_hz, x))
+            // The shared sensor transform: an accel_delay shifts the forcing's phase.
+            Model::measured(&self.physical(&run.rig, run.omega_hz, x))
         }
     }
 
@@ -714,18 +744,11 @@ fn tail_penalised(
     (differs, stats.rhs_evals)
 }
 
-/// The model of a physical parameter set, driven by the aligned crank (φ = ωt at t = 0), with
+/// [`Model::measured`]: the model of a physical parameter set, driven by the aligned crank, with
 /// `accel_delay` shifting the forcing: the accelerometer's peak came Δ after the true one, so the
 /// true crank angle is ω(t + Δ).
 pub fn model_for(phys: &Physical) -> Model {
-    let d = phys.to_dimensionless();
-    let mut m = Model::new(d);
-    if let (Some(delay_s), pendulum_model::Excitation::Crank(c)) =
-        (phys.effects.accel_delay_s, &mut m.excitation)
-    {
-        c.phi0 = d.omega * delay_s * phys.omega0_rad_s();
-    }
-    m
+    Model::measured(phys)
 }
 
 /// Cost value used for a trial whose simulation failed: finite (DE needs it) and huge.
@@ -811,9 +834,12 @@ impl StudyObjective<'_> {
             .params
             .iter()
             .zip(p)
-            .find(|(q, _)| **q == FitParam::EncoderOffset)
+            .find(|(q, _)| q.effect_name() == Some("encoder_offset"))
             .map_or(
-                self.spec.fixed.encoder_offset_rad.unwrap_or(0.0),
+                self.spec
+                    .fixed
+                    .value("encoder_offset.theta_off")
+                    .unwrap_or(0.0),
                 |(_, v)| *v,
             )
     }
@@ -1046,7 +1072,7 @@ impl Problem for StudyObjective<'_> {
                         let (lo, hi) = p.bounds();
                         (lo * w_est, hi * w_est)
                     }
-                    FitParam::EncoderOffset if free => (-0.05, 0.05),
+                    _ if free && p.effect_name() == Some("encoder_offset") => (-0.05, 0.05),
                     _ => p.bounds(),
                 })
                 .collect()

@@ -134,7 +134,7 @@ fn free_decay_fit_recovers_omega0_and_damping() {
         v(FitParam::Omega0),
         v(FitParam::Beta),
         v(FitParam::MBearing),
-        v(FitParam::EncoderOffset),
+        v(FitParam::of("encoder_offset")),
     );
     eprintln!("omega0 {w} beta {b} M {m} offset {off} E {}", fit.e_theta);
     assert!((w - OMEGA0).abs() < 0.002 * OMEGA0, "omega0 {w}");
@@ -171,7 +171,7 @@ fn regression_issue_16_params_at_bounds_are_reported() {
         .spec
         .params
         .iter()
-        .position(|p| *p == FitParam::EncoderOffset)
+        .position(|p| *p == FitParam::of("encoder_offset"))
         .expect("offset fitted");
     pinned.params[k] = 0.05;
     let notes = crate::identify::params_at_bounds(runs, &pinned);
@@ -266,7 +266,7 @@ fn free_decay_fit_recovers_constant_dry_torque() {
     let al = align(&run, &AlignConfig::default()).expect("free-decay alignment");
     let ic = estimate_state(&run, al.t0_s, &IcConfig::default()).expect("initial state");
     let steady = free_steady_state(&run, al.t0_s, &SteadyConfig::default()).expect("steady");
-    let fit = fit_linear_plus(&run, &al, &ic, &steady, FitParam::CoulombConstant);
+    let fit = fit_linear_plus(&run, &al, &ic, &steady, FitParam::of("coulomb_constant"));
     assert!(
         fit.spec.params.contains(&FitParam::DryC),
         "{:?}",

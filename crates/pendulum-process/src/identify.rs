@@ -700,7 +700,7 @@ pub fn residual_series(
         .params
         .iter()
         .zip(params)
-        .find(|(p, _)| **p == FitParam::EncoderOffset)
+        .find(|(p, _)| p.effect_name() == Some("encoder_offset"))
         .map_or(0.0, |(_, v)| *v);
     let mut out = ResidualSeries::default();
     let t_last = *times.last().unwrap_or(&0.0);

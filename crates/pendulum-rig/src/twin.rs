@@ -15,7 +15,7 @@ use std::path::{Path, PathBuf};
 
 use pendulum_model::{
     classify_poincare, integrate, ClassifyOptions, CrankDrive, Effects, Excitation, Model,
-    Physical, SimOptions, SteadyState,
+    Physical, Sensors, SimOptions, SteadyState,
 };
 use rand::{Rng, RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -668,10 +668,10 @@ fn synthesize_run(
         &ClassifyOptions::default(),
     );
 
-    // Accelerometer: true specific force at (t − Δ), gain, offsets, band-limited noise, int16.
+    // Accelerometer: true specific force at (t − Δ), gain, offsets, band-limited noise, int16;
+    // Δ, the gain and the encoder's offset are the shared sensor transform of the fit and replay.
     let lsb_per_g = 8192.0;
-    let gain = 1.0 + phys.effects.accel_gain_k_a.unwrap_or(0.0);
-    let delay_s = phys.effects.accel_delay_s.unwrap_or(0.0);
+    let sensors = Sensors::of(&phys);
     let off_max = s.accel_offset_lsb_max;
     let mut offsets = [0i16; 3];
     for o in &mut offsets {
@@ -690,12 +690,14 @@ fn synthesize_run(
     let mut lp = [0.0f64; 3];
     let mut acc_raw = Vec::with_capacity(t_acc.len());
     for &t in &t_acc {
-        let (ay, ax) = model.excitation.accel((t - delay_s) * w0);
+        let (ay, ax) = model.excitation.accel(sensors.accel_shows_s(t) * w0);
         let truth_g = [ax, 0.0, 1.0 + ay];
         let mut raw = [0i16; 3];
         for k in 0..3 {
             lp[k] = a_coef * lp[k] + white_scale * gauss(&mut rng);
-            let v = truth_g[k] * gain * lsb_per_g + lp[k] * lsb_per_g + offsets[k] as f64;
+            let v = sensors.accel_measured(truth_g[k]) * lsb_per_g
+                + lp[k] * lsb_per_g
+                + offsets[k] as f64;
             raw[k] = v.round().clamp(i16::MIN as f64, i16::MAX as f64) as i16;
         }
         acc_raw.push(raw);
@@ -706,11 +708,10 @@ fn synthesize_run(
     } else {
         0
     };
-    let theta_off = phys.effects.encoder_offset_rad.unwrap_or(0.0);
     let cpr_true = case.truth.departures.encoder_cpr_true.unwrap_or(4096.0);
     let counts: Vec<i64> = theta
         .iter()
-        .map(|&th| (cpr_true * (th + theta_off) / two_pi).floor() as i64 + zero_err)
+        .map(|&th| (cpr_true * sensors.theta_measured(th) / two_pi).floor() as i64 + zero_err)
         .collect();
     let clock_start = run.clock_start_us.unwrap_or_else(|| rng.random::<u32>());
     let stamp = |t: f64| -> u32 { clock_start.wrapping_add((t * 1e6).round() as u64 as u32) };

@@ -1,0 +1,35 @@
+//! `accel_delay`: the accelerometer's samples lag the true motion by Δ.
+
+use super::{Draw, Effect, Kind, Param, Sensors, Survey};
+
+#[derive(Debug)]
+pub struct AccelDelay;
+
+static PARAMS: [Param; 1] = [Param::real("accel_delay.Delta", "s", "s", (-0.05, 0.05))];
+
+impl Effect for AccelDelay {
+    fn name(&self) -> &'static str {
+        "accel_delay"
+    }
+    fn kind(&self) -> Kind {
+        Kind::Input
+    }
+    fn params(&self) -> &'static [Param] {
+        &PARAMS
+    }
+    fn what(&self) -> &'static str {
+        "the accelerometer's samples lag the true motion by Δ (its low-pass filter, read latency)"
+    }
+    fn term(&self) -> &'static str {
+        "the forcing leads the accelerometer-aligned clock by Δ"
+    }
+    fn survey(&self) -> Survey {
+        Survey {
+            base: "reference",
+            draws: &[("accel_delay.Delta", Draw::Uniform(0.004, 0.015))],
+        }
+    }
+    fn sense(&self, v: &[f64], s: &mut Sensors) {
+        s.accel_delay_s = v[0];
+    }
+}

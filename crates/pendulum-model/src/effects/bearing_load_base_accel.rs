@@ -1,0 +1,38 @@
+//! `bearing_load_base_accel`: the bearing load also carries the base's acceleration.
+
+use super::{Decompiled, Draw, Effect, Kind, Param, Survey};
+use crate::{Dimensionless, Physical};
+
+#[derive(Debug)]
+pub struct BearingLoadBaseAccel;
+
+impl Effect for BearingLoadBaseAccel {
+    fn name(&self) -> &'static str {
+        "bearing_load_base_accel"
+    }
+    fn kind(&self) -> Kind {
+        Kind::Dynamics
+    }
+    fn params(&self) -> &'static [Param] {
+        &[]
+    }
+    fn what(&self) -> &'static str {
+        "the bearing load also carries the base's acceleration, which the reference model leaves out"
+    }
+    fn term(&self) -> &'static str {
+        "F_N = m \\|l θ'² + (g + ÿ) cos θ − ẍ sin θ\\|"
+    }
+    fn survey(&self) -> Survey {
+        // A switch: its size is the bearing friction it changes, so μ is drawn (and judged).
+        Survey {
+            base: "reference",
+            draws: &[("mu", Draw::Uniform(0.1, 0.2))],
+        }
+    }
+    fn compile(&self, _: &[f64], _: &Physical, d: &mut Dimensionless) {
+        d.base_load = true;
+    }
+    fn decompile(&self, d: &Dimensionless, _: &Physical) -> Decompiled {
+        Decompiled::Set(d.base_load.then(Vec::new))
+    }
+}

@@ -1,0 +1,44 @@
+//! `coulomb_constant`: a load-independent dry torque T_c sgn θ' (seals, a belt-coupled motor).
+
+use super::{Decompiled, Draw, Effect, Kind, Param, Survey};
+use crate::{Dimensionless, Physical};
+
+#[derive(Debug)]
+pub struct CoulombConstant;
+
+static PARAMS: [Param; 1] = [Param::real(
+    "coulomb_constant.T_c",
+    "t_c_nm",
+    "N·m",
+    (0.0, 0.05),
+)];
+
+impl Effect for CoulombConstant {
+    fn name(&self) -> &'static str {
+        "coulomb_constant"
+    }
+    fn kind(&self) -> Kind {
+        Kind::Dynamics
+    }
+    fn params(&self) -> &'static [Param] {
+        &PARAMS
+    }
+    fn what(&self) -> &'static str {
+        "load-independent dry torque: bearing seals, a belt-coupled idle motor"
+    }
+    fn term(&self) -> &'static str {
+        "T_c sgn θ' in T_fric, and T_c in the sticking capacity"
+    }
+    fn survey(&self) -> Survey {
+        Survey {
+            base: "reference",
+            draws: &[("coulomb_constant.T_c", Draw::Uniform(0.006, 0.015))],
+        }
+    }
+    fn compile(&self, v: &[f64], p: &Physical, d: &mut Dimensionless) {
+        d.c = v[0] / p.torque_scale_nm();
+    }
+    fn decompile(&self, d: &Dimensionless, p: &Physical) -> Decompiled {
+        Decompiled::Set((d.c != 0.0).then(|| vec![d.c * p.torque_scale_nm()]))
+    }
+}

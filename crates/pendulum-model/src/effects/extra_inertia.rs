@@ -1,0 +1,44 @@
+//! `extra_inertia`: rotating inertia J besides the bob (rod, shaft, coupled rotor).
+
+use super::{Decompiled, Draw, Effect, Kind, Param, Survey};
+use crate::{Dimensionless, Physical};
+
+#[derive(Debug)]
+pub struct ExtraInertia;
+
+static PARAMS: [Param; 1] = [Param::real(
+    "extra_inertia.J",
+    "j_kg_m2",
+    "kg·m²",
+    (0.0, 0.02),
+)];
+
+impl Effect for ExtraInertia {
+    fn name(&self) -> &'static str {
+        "extra_inertia"
+    }
+    fn kind(&self) -> Kind {
+        Kind::Mass
+    }
+    fn params(&self) -> &'static [Param] {
+        &PARAMS
+    }
+    fn what(&self) -> &'static str {
+        "rotating inertia besides the bob: rod, shaft, coupled rotor"
+    }
+    fn term(&self) -> &'static str {
+        "(m l² + J) θ''"
+    }
+    fn survey(&self) -> Survey {
+        Survey {
+            base: "reference",
+            draws: &[("extra_inertia.J", Draw::Uniform(0.005, 0.02))],
+        }
+    }
+    fn compile(&self, v: &[f64], p: &Physical, d: &mut Dimensionless) {
+        d.j = v[0] / (p.m_kg * p.l_m * p.l_m);
+    }
+    fn decompile(&self, d: &Dimensionless, p: &Physical) -> Decompiled {
+        Decompiled::Set((d.j != 0.0).then(|| vec![d.j * p.m_kg * p.l_m * p.l_m]))
+    }
+}

@@ -1,0 +1,664 @@
+//! The catalogue of `effects.md`: every effect is one definition (one file in this folder, one
+//! entry in [`CATALOGUE`]) from which the rest of the project derives what it needs: parameter
+//! keys, units, refit ranges, the SI ↔ dimensionless conversion, `--param`/TOML keys, the
+//! simulator's coefficients, the sensor and forcing transform, the survey's designs, report
+//! labels and the README's table.
+//!
+//! Why a trait object list and not an enum: adding an effect must not touch a `match` in other
+//! files. The list is walked only when a model is built (once per simulation), never inside the
+//! integrator: [`Effect::compile`] writes plain numbers into [`Dimensionless`], the flat
+//! coefficient struct the right-hand side reads.
+//!
+//! Four kinds (`effects.md`): dynamics (a torque in the equation of motion), mass (inertia),
+//! input (the forcing as the accelerometer and motor give it: delay, gain, drift) and observation
+//! (the encoder's reading: offset). Input and observation effects act through one transform,
+//! [`Sensors`], shared by the twin, the fit, discover and replay.
+
+use std::collections::BTreeMap;
+
+use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+use crate::{Dimensionless, ModelError, Physical};
+
+mod accel_delay;
+mod accel_gain;
+mod bearing_load_base_accel;
+mod coulomb_bearing;
+mod coulomb_constant;
+mod encoder_offset;
+mod extra_inertia;
+mod horizontal_base;
+mod position_torque;
+mod speed_drift;
+mod stribeck;
+mod viscous_linear;
+mod viscous_quadratic;
+
+/// Every effect, in the order of `effects.md` (outputs, reports and the README follow it).
+pub static CATALOGUE: &[&dyn Effect] = &[
+    &viscous_linear::ViscousLinear,
+    &viscous_quadratic::ViscousQuadratic,
+    &coulomb_bearing::CoulombBearing,
+    &bearing_load_base_accel::BearingLoadBaseAccel,
+    &coulomb_constant::CoulombConstant,
+    &position_torque::PositionTorque,
+    &stribeck::Stribeck,
+    &horizontal_base::HorizontalBase,
+    &extra_inertia::ExtraInertia,
+    &encoder_offset::EncoderOffset,
+    &accel_delay::AccelDelay,
+    &accel_gain::AccelGain,
+    &speed_drift::SpeedDrift,
+];
+
+/// What an effect acts on (`effects.md`'s two tables, the first split by where the term goes).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Kind {
+    /// A torque of the equation of motion.
+    Dynamics,
+    /// Inertia beside the bob's.
+    Mass,
+    /// The forcing as measured or driven: the accelerometer's delay and gain, the motor's drift.
+    Input,
+    /// The encoder's reading.
+    Observation,
+}
+
+impl Kind {
+    pub fn name(self) -> &'static str {
+        match self {
+            Kind::Dynamics => "dynamics",
+            Kind::Mass => "mass",
+            Kind::Input => "input",
+            Kind::Observation => "observation",
+        }
+    }
+}
+
+/// How the survey (tests/discover.rs) draws a parameter's hidden value.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Draw {
+    /// Uniform in [lo, hi).
+    Uniform(f64, f64),
+    /// Uniform in [lo, hi), then a random sign (drawn after the size).
+    Signed(f64, f64),
+    /// An integer in lo..=hi.
+    Int(i32, i32),
+}
+
+/// A survey design: the base model discover starts from and the `--param` keys drawn (in this
+/// order; the first is the truth discover's estimate is judged against).
+#[derive(Debug, Clone, Copy)]
+pub struct Survey {
+    /// `reference`, `linear` or `dry`: the model in hand that lacks the effect.
+    pub base: &'static str,
+    pub draws: &'static [(&'static str, Draw)],
+}
+
+/// One parameter of an effect.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Param {
+    /// `effect.symbol` as `--param`, the outputs' columns and reports spell it (the reference
+    /// model's own terms use their rig.md names `a`, `b`, `mu`).
+    pub key: &'static str,
+    /// Its part of the serialized name: `coulomb_constant` + `t_c_nm` is written
+    /// `coulomb_constant_t_c_nm` (one parameter) or `t_c_nm` inside the effect's table.
+    pub field: &'static str,
+    /// SI unit (`1` for a pure number).
+    pub unit: &'static str,
+    /// Refit search range in SI units; `None`: not refitted (an integer such as k).
+    pub fit_range: Option<(f64, f64)>,
+    /// Only integers ≥ 1 are valid.
+    pub integer: bool,
+    /// Value of a parameter not given when another of the effect's is (position_torque's k = 1).
+    pub unset: f64,
+}
+
+impl Param {
+    /// A refitted real parameter.
+    pub const fn real(
+        key: &'static str,
+        field: &'static str,
+        unit: &'static str,
+        range: (f64, f64),
+    ) -> Self {
+        Self {
+            key,
+            field,
+            unit,
+            fit_range: Some(range),
+            integer: false,
+            unset: 0.0,
+        }
+    }
+}
+
+/// What [`Effect::decompile`] finds in the coefficients.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Decompiled {
+    /// The coefficients do not carry this effect (a sensor effect): keep the physical value.
+    Keep,
+    /// The effect's SI values (`None`: absent).
+    Set(Option<Vec<f64>>),
+}
+
+/// One effect of `effects.md`. Implementations are unit structs in this folder.
+pub trait Effect: Sync + std::fmt::Debug {
+    /// The stable name of `effects.md`; outputs use exactly this string.
+    fn name(&self) -> &'static str;
+    fn kind(&self) -> Kind;
+    /// Parameters in `effects.md`'s order (none: a switch, such as bearing_load_base_accel).
+    fn params(&self) -> &'static [Param];
+    /// What it is, one line (the README's table).
+    fn what(&self) -> &'static str;
+    /// The term it adds, in effects.md's notation (the README's table).
+    fn term(&self) -> &'static str;
+    /// The survey's design for this effect hidden alone.
+    fn survey(&self) -> Survey;
+
+    /// Whether its values live in [`Physical`] itself (the reference model's a, b, μ) rather
+    /// than in [`Effects`].
+    fn in_physical(&self) -> bool {
+        false
+    }
+
+    /// The effect's SI values in `p` (`None`: absent). The reference model's own terms override
+    /// this: their values live in [`Physical`]'s a, b, μ.
+    fn get(&self, p: &Physical) -> Option<Vec<f64>> {
+        p.effects.get(self.name()).map(<[f64]>::to_vec)
+    }
+
+    /// Sets (or, with `None`, removes) the effect's SI values in `p`.
+    fn set(&self, p: &mut Physical, values: Option<&[f64]>) {
+        p.effects.set(self.name(), values.map(<[f64]>::to_vec));
+    }
+
+    /// Adds the effect's term to the simulator's coefficients (`values` SI, from [`Effect::get`]).
+    /// Called once per model, never per step.
+    fn compile(&self, values: &[f64], p: &Physical, d: &mut Dimensionless) {
+        let _ = (values, p, d);
+    }
+
+    /// The inverse of [`Effect::compile`] with `p`'s m, l, g, r_b.
+    fn decompile(&self, d: &Dimensionless, p: &Physical) -> Decompiled {
+        let _ = (d, p);
+        Decompiled::Keep
+    }
+
+    /// Adds the effect to the sensor and forcing transform (input and observation effects).
+    fn sense(&self, values: &[f64], s: &mut Sensors) {
+        let _ = (values, s);
+    }
+}
+
+/// The effect called `name`.
+pub fn by_name(name: &str) -> Option<&'static dyn Effect> {
+    CATALOGUE.iter().copied().find(|e| e.name() == name)
+}
+
+/// The catalogue's names, in its order.
+pub fn names() -> Vec<&'static str> {
+    CATALOGUE.iter().map(|e| e.name()).collect()
+}
+
+/// A parameter of the catalogue, by position: Copy, comparable and hashable, for fit specs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct EffectParam {
+    effect: u16,
+    param: u16,
+}
+
+impl EffectParam {
+    /// The parameter whose key is `key` (`coulomb_constant.T_c`, `b`), or whose effect is `key`
+    /// (its first refitted parameter: `coulomb_constant`, `position_torque`).
+    pub fn find(key: &str) -> Option<Self> {
+        for (ei, e) in CATALOGUE.iter().enumerate() {
+            for (pi, p) in e.params().iter().enumerate() {
+                if p.key == key {
+                    return Some(Self {
+                        effect: ei as u16,
+                        param: pi as u16,
+                    });
+                }
+            }
+            if e.name() == key {
+                let pi = e.params().iter().position(|p| p.fit_range.is_some())?;
+                return Some(Self {
+                    effect: ei as u16,
+                    param: pi as u16,
+                });
+            }
+        }
+        None
+    }
+
+    /// Like [`EffectParam::find`], for keys the code names: panics on a key the catalogue lacks.
+    pub fn of(key: &str) -> Self {
+        Self::find(key).unwrap_or_else(|| panic!("no catalogue parameter {key:?}"))
+    }
+
+    /// Every refitted parameter of the catalogue, in its order.
+    pub fn all_fitted() -> Vec<Self> {
+        let mut out = Vec::new();
+        for (ei, e) in CATALOGUE.iter().enumerate() {
+            for (pi, p) in e.params().iter().enumerate() {
+                if p.fit_range.is_some() {
+                    out.push(Self {
+                        effect: ei as u16,
+                        param: pi as u16,
+                    });
+                }
+            }
+        }
+        out
+    }
+
+    pub fn effect(self) -> &'static dyn Effect {
+        CATALOGUE[self.effect as usize]
+    }
+
+    pub fn index(self) -> usize {
+        self.param as usize
+    }
+
+    pub fn def(self) -> &'static Param {
+        &self.effect().params()[self.param as usize]
+    }
+
+    /// The name a fit spec is written with: the effect's name for its first refitted parameter
+    /// (`effects = ["coulomb_constant"]`), else the parameter's key.
+    pub fn spec_name(self) -> &'static str {
+        let e = self.effect();
+        let first = e.params().iter().position(|p| p.fit_range.is_some());
+        if first == Some(self.index()) && self.def().key.contains('.') {
+            e.name()
+        } else {
+            self.def().key
+        }
+    }
+
+    /// The value in `p` (0 when the effect is absent).
+    pub fn value(self, p: &Physical) -> f64 {
+        self.effect()
+            .get(p)
+            .map_or(0.0, |v| v.get(self.index()).copied().unwrap_or(0.0))
+    }
+
+    /// Sets the value in `p`, switching the effect on (its other parameters at their `unset`
+    /// value) when it was absent.
+    pub fn apply(self, v: f64, p: &mut Physical) {
+        let e = self.effect();
+        let mut vals = e
+            .get(p)
+            .unwrap_or_else(|| e.params().iter().map(|q| q.unset).collect());
+        vals[self.index()] = v;
+        e.set(p, Some(&vals));
+    }
+}
+
+/// Effects of `effects.md` beyond the reference model, in SI units, by catalogue name; an
+/// absent name is an absent effect. The reference model's own terms (a, b, μ) live in
+/// [`Physical`], not here.
+///
+/// Serialized as before the catalogue (twin cases, parameter files): a switch as
+/// `name = true`, a one-parameter effect as `name_field = value`, others as a table
+/// `name = { field = value, … }`.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Effects {
+    values: BTreeMap<&'static str, Vec<f64>>,
+}
+
+impl Effects {
+    /// The SI values of effect `name` (empty for a switch), if present.
+    pub fn get(&self, name: &str) -> Option<&[f64]> {
+        self.values.get(name).map(Vec::as_slice)
+    }
+
+    /// Parameter `key` (`coulomb_constant.T_c`) if its effect is present.
+    pub fn value(&self, key: &str) -> Option<f64> {
+        let ep = EffectParam::find(key)?;
+        self.get(ep.effect().name())?.get(ep.index()).copied()
+    }
+
+    /// Whether effect `name` is present.
+    pub fn has(&self, name: &str) -> bool {
+        self.values.contains_key(name)
+    }
+
+    /// Sets or removes effect `name` (panics on a name the catalogue lacks: a programming error).
+    pub fn set(&mut self, name: &str, values: Option<Vec<f64>>) {
+        let e = by_name(name).unwrap_or_else(|| panic!("no catalogue effect {name:?}"));
+        match values {
+            Some(v) => {
+                assert_eq!(v.len(), e.params().len(), "{name}: parameter count");
+                self.values.insert(e.name(), v);
+            }
+            None => {
+                self.values.remove(e.name());
+            }
+        }
+    }
+
+    /// Sets parameter `key`, switching its effect on when absent.
+    pub fn set_value(&mut self, key: &str, v: f64) {
+        let ep = EffectParam::of(key);
+        let e = ep.effect();
+        let vals = self
+            .values
+            .entry(e.name())
+            .or_insert_with(|| e.params().iter().map(|q| q.unset).collect());
+        vals[ep.index()] = v;
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.values.is_empty()
+    }
+
+    pub fn clear(&mut self) {
+        self.values.clear();
+    }
+
+    /// Present effects with their values, in the catalogue's order.
+    pub fn iter(&self) -> impl Iterator<Item = (&'static dyn Effect, &[f64])> + '_ {
+        CATALOGUE
+            .iter()
+            .filter_map(|e| self.values.get(e.name()).map(|v| (*e, v.as_slice())))
+    }
+
+    /// `[truth.effects]` lines of a twin case, one per effect (TOML inline tables).
+    pub fn toml_lines(&self) -> String {
+        let num = |p: &Param, v: f64| {
+            if p.integer {
+                format!("{}", v as i64)
+            } else {
+                format!("{v}")
+            }
+        };
+        let mut out = Vec::new();
+        for (e, v) in self.iter() {
+            let ps = e.params();
+            out.push(match ps.len() {
+                0 => format!("{} = true", e.name()),
+                1 => format!("{}_{} = {}", e.name(), ps[0].field, num(&ps[0], v[0])),
+                _ => {
+                    let fields: Vec<String> = ps
+                        .iter()
+                        .zip(v)
+                        .map(|(p, &x)| format!("{} = {}", p.field, num(p, x)))
+                        .collect();
+                    format!("{} = {{ {} }}", e.name(), fields.join(", "))
+                }
+            });
+        }
+        out.join("\n")
+    }
+}
+
+/// One serialized entry: a switch, a number or a table of numbers.
+#[derive(Serialize, Deserialize)]
+#[serde(untagged)]
+enum Raw {
+    Switch(bool),
+    Number(f64),
+    Table(BTreeMap<String, f64>),
+}
+
+impl Serialize for Effects {
+    /// Every stored effect in the catalogue's order, an absent one as `null` (a switch as
+    /// `false`): the form truth files had before the catalogue, which readers of them expect.
+    /// TOML leaves the nulls out.
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeMap;
+        let stored: Vec<&dyn Effect> = CATALOGUE
+            .iter()
+            .copied()
+            .filter(|e| !e.in_physical())
+            .collect();
+        let mut map = s.serialize_map(Some(stored.len()))?;
+        for e in stored {
+            let ps = e.params();
+            let v = self.get(e.name());
+            let key = serial_key(e);
+            match (ps.len(), v) {
+                (0, v) => map.serialize_entry(&key, &Raw::Switch(v.is_some()))?,
+                (_, None) => map.serialize_entry(&key, &Option::<Raw>::None)?,
+                (1, Some(v)) => map.serialize_entry(&key, &Raw::Number(v[0]))?,
+                (_, Some(v)) => map.serialize_entry(
+                    &key,
+                    &Raw::Table(
+                        ps.iter()
+                            .map(|p| p.field.to_string())
+                            .zip(v.iter().copied())
+                            .collect(),
+                    ),
+                )?,
+            }
+        }
+        map.end()
+    }
+}
+
+impl<'de> Deserialize<'de> for Effects {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        use serde::de::Error;
+        let raw = BTreeMap::<String, Option<Raw>>::deserialize(d)?;
+        let mut out = Effects::default();
+        for (key, value) in raw {
+            let found = CATALOGUE.iter().copied().find(|e| serial_key(*e) == key);
+            let Some(e) = found else {
+                let expected: Vec<String> = CATALOGUE.iter().map(|e| serial_key(*e)).collect();
+                return Err(D::Error::custom(format!(
+                    "unknown effect {key:?}: expected one of {}",
+                    expected.join(", ")
+                )));
+            };
+            let ps = e.params();
+            // `null`: absent (truth files list every effect).
+            let Some(value) = value else { continue };
+            let vals = match (value, ps.len()) {
+                (Raw::Switch(on), 0) => on.then(Vec::new),
+                (Raw::Number(v), 1) => Some(vec![v]),
+                (Raw::Table(mut t), n) if n > 1 => {
+                    let mut v = Vec::with_capacity(n);
+                    for p in ps {
+                        v.push(t.remove(p.field).ok_or_else(|| {
+                            D::Error::custom(format!("{key}: missing field {:?}", p.field))
+                        })?);
+                    }
+                    if let Some(extra) = t.keys().next() {
+                        return Err(D::Error::custom(format!(
+                            "{key}: unknown field {extra:?}: expected {}",
+                            ps.iter().map(|p| p.field).collect::<Vec<_>>().join(", ")
+                        )));
+                    }
+                    Some(v)
+                }
+                _ => {
+                    return Err(D::Error::custom(format!(
+                        "{key}: expected {}",
+                        match ps.len() {
+                            0 => "true or false".to_string(),
+                            1 => "a number".to_string(),
+                            _ => "a table".to_string(),
+                        }
+                    )))
+                }
+            };
+            if let Some(v) = vals {
+                for (p, x) in ps.iter().zip(&v) {
+                    if !x.is_finite() || (p.integer && (*x < 1.0 || x.fract() != 0.0)) {
+                        return Err(D::Error::custom(format!(
+                            "{key}.{}: {x} is not {}",
+                            p.field,
+                            if p.integer {
+                                "an integer ≥ 1"
+                            } else {
+                                "a finite number"
+                            }
+                        )));
+                    }
+                }
+                out.values.insert(e.name(), v);
+            }
+        }
+        Ok(out)
+    }
+}
+
+/// The serialized key of an effect (see [`Effects`]).
+fn serial_key(e: &dyn Effect) -> String {
+    match e.params() {
+        [p] => format!("{}_{}", e.name(), p.field),
+        _ => e.name().to_string(),
+    }
+}
+
+/// Every `--param` key of the effects (`coulomb_constant.T_c`, a switch's `name.on`), in the
+/// catalogue's order; the reference model's own `a`, `b`, `mu` are physical keys.
+pub fn param_keys() -> Vec<&'static str> {
+    let mut out = Vec::new();
+    for e in CATALOGUE {
+        if e.params().is_empty() {
+            out.push(switch_key(*e));
+        }
+        out.extend(e.params().iter().map(|p| p.key).filter(|k| k.contains('.')));
+    }
+    out
+}
+
+/// The `--param` key of a switch: `name.on`.
+fn switch_key(e: &dyn Effect) -> &'static str {
+    static KEYS: std::sync::OnceLock<Vec<(&'static str, String)>> = std::sync::OnceLock::new();
+    let keys = KEYS.get_or_init(|| {
+        CATALOGUE
+            .iter()
+            .map(|e| (e.name(), format!("{}.on", e.name())))
+            .collect()
+    });
+    keys.iter()
+        .find(|(n, _)| *n == e.name())
+        .map(|(_, k)| k.as_str())
+        .expect("every effect has a switch key")
+}
+
+/// Applies one `--param` effect assignment to `p`. Returns `Ok(false)` when `key` is no effect
+/// key (a physical or dimensionless one).
+pub fn apply_key(p: &mut Physical, key: &str, v: f64) -> Result<bool, ModelError> {
+    for e in CATALOGUE {
+        if e.params().is_empty() && key == switch_key(*e) {
+            e.set(p, (v != 0.0).then_some(&[]));
+            return Ok(true);
+        }
+        if let Some(i) = e.params().iter().position(|q| q.key == key) {
+            if e.params()[i].integer && (v < 1.0 || v.fract() != 0.0) {
+                return Err(ModelError::BadParamValue {
+                    key: key.to_string(),
+                    value: v.to_string(),
+                    expected: "an integer ≥ 1".into(),
+                });
+            }
+            EffectParam {
+                effect: CATALOGUE
+                    .iter()
+                    .position(|x| x.name() == e.name())
+                    .expect("in the catalogue") as u16,
+                param: i as u16,
+            }
+            .apply(v, p);
+            return Ok(true);
+        }
+    }
+    Ok(false)
+}
+
+/// The input and observation effects as one transform between the pendulum and what the
+/// sensors report: used by the twin to make captures, and by the fit, discover and replay to
+/// compare a model with them.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Sensors {
+    /// `encoder_offset`: measured θ = true θ + this, rad.
+    pub encoder_offset_rad: f64,
+    /// `accel_delay`: the accelerometer's sample stamped τ shows the motion at τ − this, s.
+    pub accel_delay_s: f64,
+    /// `accel_gain`: measured acceleration = (1 + this) × true.
+    pub accel_gain_k_a: f64,
+}
+
+impl Default for Sensors {
+    fn default() -> Self {
+        Self {
+            encoder_offset_rad: 0.0,
+            accel_delay_s: 0.0,
+            accel_gain_k_a: 0.0,
+        }
+    }
+}
+
+impl Sensors {
+    /// The transform of `p`'s input and observation effects.
+    pub fn of(p: &Physical) -> Self {
+        let mut s = Sensors::default();
+        for e in CATALOGUE {
+            if let Some(v) = e.get(p) {
+                e.sense(&v, &mut s);
+            }
+        }
+        s
+    }
+
+    /// The encoder's angle for the true θ, rad.
+    pub fn theta_measured(&self, theta_rad: f64) -> f64 {
+        theta_rad + self.encoder_offset_rad
+    }
+
+    /// The true θ for the encoder's angle, rad.
+    pub fn theta_true(&self, theta_measured_rad: f64) -> f64 {
+        theta_measured_rad - self.encoder_offset_rad
+    }
+
+    /// The time whose motion the accelerometer's sample stamped `t_s` shows, s.
+    pub fn accel_shows_s(&self, t_s: f64) -> f64 {
+        t_s - self.accel_delay_s
+    }
+
+    /// The accelerometer's reading of a true acceleration (any unit).
+    pub fn accel_measured(&self, a: f64) -> f64 {
+        a * (1.0 + self.accel_gain_k_a)
+    }
+
+    /// Crank phase by which the true forcing leads a clock aligned on the accelerometer's peak,
+    /// rad, for dimensionless crank speed `omega` and ω0 in rad/s.
+    pub fn forcing_lead_rad(&self, omega: f64, omega0_rad_s: f64) -> f64 {
+        omega * self.accel_delay_s * omega0_rad_s
+    }
+}
+
+/// The README's effect table (checked against README.md by a test).
+pub fn markdown_table() -> String {
+    let mut s = String::from(
+        "| name | kind | parameters (`--param` key, SI unit) | what it is | term |\n|---|---|---|---|---|\n",
+    );
+    for e in CATALOGUE {
+        let params = if e.params().is_empty() {
+            format!("`{}` (switch)", switch_key(*e))
+        } else {
+            e.params()
+                .iter()
+                .map(|p| format!("`{}` {}", p.key, p.unit))
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        s.push_str(&format!(
+            "| `{}` | {} | {} | {} | {} |\n",
+            e.name(),
+            e.kind().name(),
+            params,
+            e.what(),
+            e.term()
+        ));
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests;
