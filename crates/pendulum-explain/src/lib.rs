@@ -9,7 +9,7 @@ pub mod decay;
 mod linalg;
 
 pub use decay::{
-    diagnose_decay, envelope, loss_band_contradicts, omega_n_estimate, turning_points,
+    diagnose_decay, envelope, first_swing, loss_band_contradicts, omega_n_estimate, turning_points,
     turning_points_with, Candidate, Coef, DecayDiagnosis, DecayError, DecayOptions, EnvelopeFit,
     EnvelopeRow, Estimate, HeldOutScore, KnownRig, LossBand, ModelFit, PeriodLaw, ReferenceModel,
     Resolution, Term, TurningPoint, Unexplained, DECAY_RULE, LOSS_BAND_FACTOR, MIN_SWING_STEPS,

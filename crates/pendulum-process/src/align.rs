@@ -191,13 +191,15 @@ pub fn align_free_decay(run: &RunData) -> Result<Alignment, ProcessError> {
     };
     let (t, th) = (&run.enc_t_s, &run.theta_rad);
     let tps = pendulum_explain::turning_points(t, th);
+    // A hold before the release (a hand's tremor) is no swing.
+    let tps = &tps[pendulum_explain::first_swing(&tps)..];
     if tps.len() < 3 {
         return Err(fail(format!(
             "no shaker (no omega_hz) and only {} turning points: a free decay needs a few swings",
             tps.len()
         )));
     }
-    let w0 = pendulum_explain::omega_n_estimate(&tps);
+    let w0 = pendulum_explain::omega_n_estimate(tps);
     if !(w0.is_finite() && w0 > 0.0) {
         return Err(fail(format!(
             "free decay: no natural frequency from the swing periods ({w0})"

@@ -279,3 +279,56 @@ fn free_decay_fit_recovers_constant_dry_torque() {
     assert!((b - BETA).abs() < 0.02 * BETA, "beta {b}");
     assert!((c - C).abs() < 0.02 * C, "c {c}");
 }
+
+/// Issue 13 (a thesis recording): a pendulum held near upright by a trembling hand before its
+/// release. t = 0 is the turning point the first real swing starts from (the tremor's last
+/// maximum, at 5/6 s), not the hold's first tremor.
+#[test]
+fn regression_issue_13_a_hold_near_upright_is_no_swing() {
+    let d = Dimensionless {
+        beta: BETA,
+        m_coulomb: M_BEARING,
+        ..Dimensionless::conservative()
+    };
+    let model = Model::with_excitation(d, Excitation::None);
+    let (hold_s, dur_s, dt) = (1.0, 20.0, 1e-3);
+    let n = (dur_s / dt) as usize;
+    let times: Vec<f64> = (0..n).map(|i| i as f64 * dt).collect();
+    // The tremor: 3.0 + 0.01 (1 − cos 6πt) rad, ending at 3.0 rad at rest at the release.
+    let hold: Vec<f64> = times
+        .iter()
+        .filter(|&&t| t < hold_s)
+        .map(|&t| 3.0 + 0.01 * (1.0 - (6.0 * std::f64::consts::PI * t).cos()))
+        .collect();
+    let free: Vec<f64> = times
+        .iter()
+        .filter(|&&t| t >= hold_s)
+        .map(|t| (t - hold_s) * OMEGA0)
+        .collect();
+    let mut th = hold;
+    integrate(
+        &model,
+        &SimOptions::with_tol(1e-10),
+        0.0,
+        [3.0, 0.0],
+        *free.last().unwrap(),
+        free.iter().copied(),
+        |s| {
+            th.push(s.theta);
+            ControlFlow::Continue(())
+        },
+    )
+    .unwrap();
+    let q = std::f64::consts::TAU / 40000.0;
+    let run = RunData {
+        theta_rad: th.iter().map(|v| (v / q).floor() * q + 0.5 * q).collect(),
+        enc_t_s: times,
+        ..synthetic_decay()
+    };
+    let al = align(&run, &AlignConfig::default()).unwrap();
+    assert!(
+        (al.t0_s - 5.0 / 6.0).abs() < 0.02,
+        "t0 = {} s: the hold's tremor was taken for a swing",
+        al.t0_s
+    );
+}
