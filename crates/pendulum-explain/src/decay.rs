@@ -1016,11 +1016,26 @@ pub struct PeriodLaw {
     pub rms_rel: f64,
     /// The interval of u excludes 1: the period does not follow the gravity law.
     pub departs: bool,
+    /// The interval of u leaves part of [0, 1] out: the swings' amplitudes say something about
+    /// gravity's share. Small swings (the period's amplitude dependence ∝ A² below the timing
+    /// noise) leave it anywhere in [0, 1]; then no interval is printed.
+    pub determined: bool,
 }
 
 impl PeriodLaw {
     /// One line for the report.
     pub fn describe(&self) -> String {
+        if !self.determined {
+            return format!(
+                "period law ({} half swings, A {:.3}–{:.3} rad, rms {:.2} %): undetermined — the \
+                 swings are too small for their periods to tell gravity from a spring (gravity's \
+                 share anywhere in [0, 1]); stiffness not tried",
+                self.swings,
+                self.amplitude_from_rad,
+                self.amplitude_to_rad,
+                100.0 * self.rms_rel,
+            );
+        }
         format!(
             "period law ({} half swings, A {:.3}–{:.3} rad, rms {:.2} %): gravity's share of the \
              small-swing stiffness u = {:.4} [{:.4}, {:.4}], kappa = {:.3e} [{:.3e}, {:.3e}]: {}",
@@ -1133,6 +1148,7 @@ fn period_law(tps: &[TurningPoint], step_rad: f64, z: f64) -> Option<PeriodLaw> 
         omega_n_rad_s: (-m).exp(),
         rms_rel: (s2 * (n - 2) as f64 / n as f64).sqrt(),
         departs: u_hi < 1.0,
+        determined: u_lo > 0.01 || u_hi < 1.0,
     })
 }
 
@@ -3422,6 +3438,38 @@ mod tests {
     /// gravity alone would make it, the stiffness is named with κ within 10 %, and the period
     /// drift it left unexplained is gone. A plain gravity pendulum
     /// (the same run without the spring) gets nothing named, the stiffness not even tried.
+    /// Issue 16: swings of a few hundredths of a radian cannot tell gravity from a spring by
+    /// their periods (the amplitude dependence ∝ A² is below the timing noise); the period law
+    /// says so instead of printing an interval of u over all of [0, 1]. Large swings of the same
+    /// pendulum determine it and find the gravity law.
+    #[test]
+    fn regression_issue_16_period_law_of_small_swings_is_undetermined() {
+        let (omega_g, gamma) = (5.0, 0.02);
+        let opts = DecayOptions {
+            resolution_rad: Some(std::f64::consts::TAU / 4096.0),
+            ..DecayOptions::default()
+        };
+        for (a0, want_determined) in [(0.12, false), (1.5, true)] {
+            let (t, th) = rk4_spring_decay(omega_g, 0.0, gamma, a0, 30.0, 200.0);
+            let d = diagnose_decay(&t, &th, &opts).unwrap();
+            let law = d.period_law.as_ref().expect("no period law");
+            assert_eq!(
+                law.determined,
+                want_determined,
+                "A0 = {a0}: {}",
+                law.describe()
+            );
+            assert!(!law.departs, "A0 = {a0}: {}", law.describe());
+            if !want_determined {
+                assert!(
+                    law.describe().contains("undetermined"),
+                    "{}",
+                    law.describe()
+                );
+            }
+        }
+    }
+
     #[test]
     fn regression_issue_16_torsion_spring_named_as_stiffness() {
         let (omega_g, gamma) = (5.0, 0.08);
