@@ -162,6 +162,27 @@ pub fn generation_bar(
     (bar, f)
 }
 
+/// Every run a fitted model saw (identify runs from the fit, validate runs from the
+/// validation) with its data and alignment: a model fitted on re-aligned runs (speed_drift) is
+/// replayed on its own alignment. Runs missing from the context are skipped.
+fn fitted_runs<'a>(
+    ctx: &'a Context,
+    fit: &'a FitOutcome,
+    validation: Option<&'a [RunFit]>,
+) -> impl Iterator<Item = (&'a RunFit, &'a RunData, &'a pendulum_process::Alignment)> {
+    fit.runs
+        .iter()
+        .chain(validation.unwrap_or(&[]))
+        .filter_map(move |rf| {
+            let run = ctx.runs.iter().find(|r| r.id == rf.id)?;
+            let al = fit
+                .alignments
+                .get(&rf.id)
+                .or_else(|| ctx.alignments.get(&rf.id))?;
+            Some((rf, run, al))
+        })
+}
+
 /// Residual histories of every fitted model on every run it saw (identify runs from the fit,
 /// validate runs from the validation).
 pub fn residuals_of(
@@ -172,22 +193,7 @@ pub fn residuals_of(
 ) -> Result<Vec<(String, Role, ResidualSeries)>, JobError> {
     let window = pendulum_process::identify::Window::default();
     let mut out = Vec::new();
-    let mut all: Vec<&RunFit> = fit.runs.iter().collect();
-    if let Some(v) = validation {
-        all.extend(v.iter());
-    }
-    for rf in all {
-        let Some(run) = ctx.runs.iter().find(|r| r.id == rf.id) else {
-            continue;
-        };
-        // A model fitted on re-aligned runs (speed_drift) is replayed on its own alignment.
-        let Some(al) = fit
-            .alignments
-            .get(&rf.id)
-            .or_else(|| ctx.alignments.get(&rf.id))
-        else {
-            continue;
-        };
+    for (rf, run, al) in fitted_runs(ctx, fit, validation) {
         let series = residual_series(run, al, &fit.spec, &fit.params, rf.ic_fit, &window, span_s)?;
         out.push((rf.id.clone(), rf.role, series));
     }
@@ -206,21 +212,7 @@ pub fn segment_residuals_of(
     validation: Option<&[RunFit]>,
 ) -> Result<Vec<SegmentResiduals>, JobError> {
     let mut out = Vec::new();
-    let mut all: Vec<&RunFit> = fit.runs.iter().collect();
-    if let Some(v) = validation {
-        all.extend(v.iter());
-    }
-    for rf in all {
-        let Some(run) = ctx.runs.iter().find(|r| r.id == rf.id) else {
-            continue;
-        };
-        let Some(al) = fit
-            .alignments
-            .get(&rf.id)
-            .or_else(|| ctx.alignments.get(&rf.id))
-        else {
-            continue;
-        };
+    for (rf, run, al) in fitted_runs(ctx, fit, validation) {
         // The window the run was fitted or validated with.
         let window = match rf.role {
             Role::Identify => ctx.fit_window,

@@ -31,8 +31,20 @@ fn synthetic_decay_with(beta: f64, m_coulomb: f64, c: f64) -> RunData {
         c,
         ..Dimensionless::conservative()
     };
+    decay_after_hold(d, 0.3, 24.0, OFFSET, &|_| 0.8)
+}
+
+/// A free decay of `d` at 1 kHz on a 40000-count encoder (centre off by `offset`), released at
+/// `hold_s` from the hold's last angle at rest; `hold(t)` is the angle before the release.
+fn decay_after_hold(
+    d: Dimensionless,
+    hold_s: f64,
+    dur_s: f64,
+    offset: f64,
+    hold: &dyn Fn(f64) -> f64,
+) -> RunData {
     let model = Model::with_excitation(d, Excitation::None);
-    let (hold_s, dur_s, dt) = (0.3, 24.0, 1e-3);
+    let dt = 1e-3;
     let n = (dur_s / dt) as usize;
     let times: Vec<f64> = (0..n).map(|i| i as f64 * dt).collect();
     let free: Vec<f64> = times
@@ -40,12 +52,16 @@ fn synthetic_decay_with(beta: f64, m_coulomb: f64, c: f64) -> RunData {
         .filter(|&&t| t >= hold_s)
         .map(|t| (t - hold_s) * OMEGA0)
         .collect();
-    let mut th = Vec::new();
+    let mut th: Vec<f64> = times
+        .iter()
+        .filter(|&&t| t < hold_s)
+        .map(|&t| hold(t))
+        .collect();
     integrate(
         &model,
         &SimOptions::with_tol(1e-10),
         0.0,
-        [0.8, 0.0],
+        [hold(hold_s), 0.0],
         *free.last().unwrap(),
         free.iter().copied(),
         |s| {
@@ -55,9 +71,9 @@ fn synthetic_decay_with(beta: f64, m_coulomb: f64, c: f64) -> RunData {
     )
     .unwrap();
     let q = std::f64::consts::TAU / 40000.0;
-    let theta: Vec<f64> = std::iter::repeat_n(0.8, n - th.len())
-        .chain(th)
-        .map(|v| ((v + OFFSET) / q).floor() * q + 0.5 * q)
+    let theta: Vec<f64> = th
+        .iter()
+        .map(|v| ((v + offset) / q).floor() * q + 0.5 * q)
         .collect();
     RunData {
         id: "free".into(),
@@ -290,41 +306,9 @@ fn regression_issue_13_a_hold_near_upright_is_no_swing() {
         m_coulomb: M_BEARING,
         ..Dimensionless::conservative()
     };
-    let model = Model::with_excitation(d, Excitation::None);
-    let (hold_s, dur_s, dt) = (1.0, 20.0, 1e-3);
-    let n = (dur_s / dt) as usize;
-    let times: Vec<f64> = (0..n).map(|i| i as f64 * dt).collect();
     // The tremor: 3.0 + 0.01 (1 − cos 6πt) rad, ending at 3.0 rad at rest at the release.
-    let hold: Vec<f64> = times
-        .iter()
-        .filter(|&&t| t < hold_s)
-        .map(|&t| 3.0 + 0.01 * (1.0 - (6.0 * std::f64::consts::PI * t).cos()))
-        .collect();
-    let free: Vec<f64> = times
-        .iter()
-        .filter(|&&t| t >= hold_s)
-        .map(|t| (t - hold_s) * OMEGA0)
-        .collect();
-    let mut th = hold;
-    integrate(
-        &model,
-        &SimOptions::with_tol(1e-10),
-        0.0,
-        [3.0, 0.0],
-        *free.last().unwrap(),
-        free.iter().copied(),
-        |s| {
-            th.push(s.theta);
-            ControlFlow::Continue(())
-        },
-    )
-    .unwrap();
-    let q = std::f64::consts::TAU / 40000.0;
-    let run = RunData {
-        theta_rad: th.iter().map(|v| (v / q).floor() * q + 0.5 * q).collect(),
-        enc_t_s: times,
-        ..synthetic_decay()
-    };
+    let tremor = |t: f64| 3.0 + 0.01 * (1.0 - (6.0 * std::f64::consts::PI * t).cos());
+    let run = decay_after_hold(d, 1.0, 20.0, 0.0, &tremor);
     let al = align(&run, &AlignConfig::default()).unwrap();
     assert!(
         (al.t0_s - 5.0 / 6.0).abs() < 0.02,
