@@ -1443,11 +1443,7 @@ pub fn discover(
             &cols,
             crate::sparse::family_of(&c.effect),
         )
-        .filter(|(d, terms)| {
-            *d < crate::sparse::PARTIAL_BIC
-                // The same shape as the candidate's is no freer description.
-                && !terms.is_empty()
-        });
+        .filter(|cmp| cmp.partial());
         let accepted = partial.is_none()
             && excludes_zero
             && practically_significant(&c.effect, est, jitter_s, bob_inertia)
@@ -1458,20 +1454,24 @@ pub fn discover(
         // A clear departure that the best candidate fits only with an impossible value is real
         // and unnamed. (A candidate the refit merely does not confirm is weak evidence, not a
         // departure: it is refused in its row.)
-        if let Some((d, terms)) = partial
+        if let Some(cmp) = partial
             .as_ref()
             .filter(|_| excludes_zero && sc.delta_bic < cfg.screen_threshold && possible)
         {
-            let names: Vec<&str> = terms
+            let d = cmp.delta_bic_over_candidate;
+            let names: Vec<&str> = cmp
+                .terms
                 .iter()
                 .map(|&j| crate::sparse::LIBRARY[j].name)
                 .collect();
             refused = Some(format!(
                 "the best catalogue candidate, {} (ΔBIC {:.1}), explains the departure only in \
-                 part: a freer shape in the same variable ({}) does better by ΔBIC {d:.1}",
+                 part: a freer shape in the same variable ({}) does better by ΔBIC {d:.1} (the \
+                 candidate explains {:.0} % of it)",
                 c.effect,
                 sc.delta_bic,
                 names.join(" + "),
+                100.0 * cmp.candidate_share(),
             ));
         }
         if excludes_zero && sc.delta_bic < cfg.screen_threshold && !possible {

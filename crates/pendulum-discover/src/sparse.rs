@@ -464,10 +464,47 @@ pub fn family_of(effect: &str) -> &'static [Variable] {
 /// the candidate to count as a partial explanation of a departure outside the catalogue.
 pub const PARTIAL_BIC: f64 = -10.0;
 
+/// A candidate is a partial explanation only when it also explains less than this share of what
+/// the freer description explains (each as its ΔBIC over the current model): against an
+/// effect of ΔBIC −3,500, another simulator's small differences (a few harmonics more) are worth
+/// ΔBIC −200, while a torsion spring fitted as `position_torque` leaves as much again (share
+/// about 0.5) and a mislabelled encoder far more.
+pub const PARTIAL_SHARE: f64 = 0.75;
+
+/// What [`family_beats_candidate`] measured.
+#[derive(Debug, Clone)]
+pub struct FamilyComparison {
+    /// ΔBIC of the freer description over the candidate (negative: better).
+    pub delta_bic_over_candidate: f64,
+    /// ΔBIC of the candidate over the current model.
+    pub candidate_delta_bic: f64,
+    /// The description's library terms.
+    pub terms: Vec<usize>,
+}
+
+impl FamilyComparison {
+    /// The candidate's share of what the freer description explains (1: all of it).
+    pub fn candidate_share(&self) -> f64 {
+        let total = self.candidate_delta_bic + self.delta_bic_over_candidate.min(0.0);
+        if total < 0.0 {
+            self.candidate_delta_bic.min(0.0) / total
+        } else {
+            1.0
+        }
+    }
+
+    /// The candidate is a partial explanation of a departure it does not describe.
+    pub fn partial(&self) -> bool {
+        !self.terms.is_empty()
+            && self.delta_bic_over_candidate < PARTIAL_BIC
+            && self.candidate_share() < PARTIAL_SHARE
+    }
+}
+
 /// How much better (ΔBIC on the identify rows, negative: better) the best generic description
 /// restricted to `family` explains the weak-form target on top of `current` columns than the
-/// catalogue candidate's columns `candidate` (indices into [`WeakRow::x`]) do, with that
-/// description's library terms. `None` when the family is empty or nothing fits. A catalogue
+/// catalogue candidate's columns `candidate` (indices into [`WeakRow::x`]) do, beside the
+/// candidate's own ΔBIC over `current`, with that description's library terms. `None` when the family is empty or nothing fits. A catalogue
 /// entry is the cause of a departure only if no freer shape in the same variable does clearly
 /// better: a torsion spring (−k θ, θ unwrapped) is fitted by `position_torque` k = 1 only on
 /// small swings, and then only in part.
@@ -476,7 +513,7 @@ pub fn family_beats_candidate(
     current: &[usize],
     candidate: &[usize],
     family: &[Variable],
-) -> Option<(f64, Vec<usize>)> {
+) -> Option<FamilyComparison> {
     if family.is_empty() || id_rows.len() < 20 {
         return None;
     }
@@ -504,15 +541,21 @@ pub fn family_beats_candidate(
     let base: Vec<usize> = (0..nc).collect();
     let cand: Vec<usize> = (0..nc + ne).collect();
     let cand_bic = bic(wls(&design, &y, &w, &cand)?.2, cand.len());
+    let base_bic = if base.is_empty() {
+        bic(y.iter().zip(&w).map(|(v, wi)| wi * v * v).sum(), 0)
+    } else {
+        bic(wls(&design, &y, &w, &base)?.2, base.len())
+    };
     let pool: Vec<usize> = (0..LIBRARY.len())
         .filter(|&j| family.contains(&LIBRARY[j].variable))
         .map(|j| nc + ne + j)
         .collect();
     let (chosen, gen_bic) = forward_select(&design, &y, &w, &base, &pool)?;
-    Some((
-        gen_bic - cand_bic,
-        chosen.iter().map(|c| c - nc - ne).collect(),
-    ))
+    Some(FamilyComparison {
+        delta_bic_over_candidate: gen_bic - cand_bic,
+        candidate_delta_bic: cand_bic - base_bic,
+        terms: chosen.iter().map(|c| c - nc - ne).collect(),
+    })
 }
 
 /// Forward selection under BIC from `base` columns over `pool` (at most [`MAX_TERMS`], each
