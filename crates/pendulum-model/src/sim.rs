@@ -10,6 +10,13 @@
 //! output. At the event the applied torque Q (everything but friction, at θ̇ = 0) is compared with
 //! the static capacity C = M·N + c + s: |Q| ≤ C → stick (θ̇ = 0 exactly, θ fixed) until
 //! |Q(t)| > C(t); otherwise slip in direction sgn Q.
+//!
+//! A generator behind a rectifier, g·(|θ̇| − w)⁺ sgn θ̇, is a second switching surface, |θ̇| = w:
+//! the torque is continuous there but its slope is not, and a step straddling the kink loses
+//! DOPRI5's order (its error estimate no longer measures its error). So it is handled like
+//! θ̇ = 0: within a step the generator is in a fixed mode (off, or on on one side, where its term
+//! is the smooth g·(θ̇ ∓ w)), and a step that ends on the other side of the surface is cut at the
+//! crossing, located on the dense output.
 
 use std::ops::ControlFlow;
 use std::sync::Arc;
@@ -106,9 +113,30 @@ impl Model {
         (q, p.m_coulomb * load + p.c + p.s_break)
     }
 
+    /// The generator's mode at θ̇: ±1 on (beyond the dead band on that side), 0 off (inside it).
+    /// Without a dead band (w = 0) its term g·θ̇ is smooth: always "on" with sign 1.
+    #[inline]
+    pub fn gen_mode(&self, theta_dot: f64) -> f64 {
+        let w = self.params.gen_w;
+        if w == 0.0 || theta_dot > w {
+            1.0
+        } else if theta_dot < -w {
+            -1.0
+        } else {
+            0.0
+        }
+    }
+
     /// θ̈ while slipping in direction `dir` (±1; 0 when there is no dry friction).
     #[inline]
     pub fn accel(&self, t: f64, theta: f64, theta_dot: f64, dir: f64) -> f64 {
+        self.accel_in(t, theta, theta_dot, dir, self.gen_mode(theta_dot))
+    }
+
+    /// θ̈ with the generator held in mode `gen` ([`Model::gen_mode`]): the integrator's smooth
+    /// right-hand side within a step.
+    #[inline(always)]
+    fn accel_in(&self, t: f64, theta: f64, theta_dot: f64, dir: f64, gen: f64) -> f64 {
         let p = &self.params;
         let (ay, ax) = self.base_accel(t);
         let (s, c) = sin_cos(theta);
@@ -128,6 +156,10 @@ impl Model {
                 dry += p.s_break * (-x * x).exp();
             }
             q -= dry * dir;
+        }
+        // Tested first: most models have no generator, and those that do spend time in its band.
+        if p.gen_c != 0.0 && gen != 0.0 {
+            q -= p.gen_c * (theta_dot - gen * p.gen_w);
         }
         if p.p != 0.0 {
             q -= p.p * (p.k as f64 * theta + p.phi_p).sin();
@@ -274,6 +306,9 @@ pub struct SimStats {
     pub rhs_evals: u64,
     /// θ̇ = 0 events located.
     pub events: u64,
+    /// Crossings of the generator's dead-band edge |θ̇| = w located.
+    #[serde(default)]
+    pub band_events: u64,
     /// Times the pendulum stuck.
     pub sticks: u64,
     /// True if the integration ended stuck (θ̇ = 0 exactly).
@@ -434,6 +469,10 @@ where
     } else {
         dir = 0.0;
     }
+    // The generator's mode (see the module docs); it switches only where its dead band has an
+    // edge (w > 0).
+    let gen_switch = model.params.gen_c != 0.0 && model.params.gen_w > 0.0;
+    let mut gen = model.gen_mode(y[1]);
     // Events that made no progress in a row (a guard against Zeno behaviour).
     let mut idle_events = 0u32;
     let mut h = opts
@@ -476,6 +515,7 @@ where
                     t = tb;
                     let (q, _) = model.static_balance(t, y[0]);
                     dir = q.signum();
+                    gen = model.gen_mode(0.0);
                     stuck = false;
                     need_k1 = true;
                     h = h.min(1e-2);
@@ -490,7 +530,7 @@ where
             });
         }
         if need_k1 {
-            k1 = f(model, t, y, dir);
+            k1 = f(model, t, y, dir, gen);
             stats.rhs_evals += 1;
             need_k1 = false;
         }
@@ -499,18 +539,20 @@ where
             h = t_end - t;
         }
         // One DOPRI5 step.
-        let k2 = f(model, t + dp::C2 * h, add(y, h, &[(dp::A21, k1)]), dir);
+        let k2 = f(model, t + dp::C2 * h, add(y, h, &[(dp::A21, k1)]), dir, gen);
         let k3 = f(
             model,
             t + dp::C3 * h,
             add(y, h, &[(dp::A31, k1), (dp::A32, k2)]),
             dir,
+            gen,
         );
         let k4 = f(
             model,
             t + dp::C4 * h,
             add(y, h, &[(dp::A41, k1), (dp::A42, k2), (dp::A43, k3)]),
             dir,
+            gen,
         );
         let k5 = f(
             model,
@@ -521,6 +563,7 @@ where
                 &[(dp::A51, k1), (dp::A52, k2), (dp::A53, k3), (dp::A54, k4)],
             ),
             dir,
+            gen,
         );
         let y6 = add(
             y,
@@ -533,7 +576,7 @@ where
                 (dp::A65, k5),
             ],
         );
-        let k6 = f(model, t + h, y6, dir);
+        let k6 = f(model, t + h, y6, dir, gen);
         let y_new = add(
             y,
             h,
@@ -545,7 +588,7 @@ where
                 (dp::A76, k6),
             ],
         );
-        let k7 = f(model, t + h, y_new, dir);
+        let k7 = f(model, t + h, y_new, dir, gen);
         stats.rhs_evals += 6;
         let mut err = 0.0;
         for i in 0..2 {
@@ -621,6 +664,60 @@ where
         let t_new = if last { t_end } else { t + h };
         // Did θ̇ reach zero against the slip direction?
         let crossing = dir != 0.0 && y_new[1] * dir <= 0.0;
+        // Did θ̇ cross the generator's dead-band edge? On: fell back to w on its side (or
+        // below); off: left the band on either side.
+        let band = gen_switch
+            && if gen != 0.0 {
+                y_new[1] * gen <= model.params.gen_w
+            } else {
+                y_new[1].abs() > model.params.gen_w
+            };
+        if band {
+            let dense = dense();
+            let w = model.params.gen_w;
+            // g(t) = σθ̇ − κ, > 0 at t and ≤ 0 at the crossing.
+            let (side, sigma, kappa) = if gen != 0.0 {
+                (gen, gen, w)
+            } else {
+                let side = y_new[1].signum();
+                (side, -side, -w)
+            };
+            let tb = locate_level(&dense, t, t_new, sigma, kappa);
+            // θ̇ = 0 (dry friction) can only come first from inside the band.
+            let td = if crossing && gen == 0.0 {
+                locate_zero(&dense, t, t_new, dir)
+            } else {
+                f64::INFINITY
+            };
+            if tb < td {
+                stats.band_events += 1;
+                while let Some(&ts) = times.peek() {
+                    if ts < tb {
+                        times.next();
+                        emit!(ts, dense.eval(ts));
+                    } else {
+                        break;
+                    }
+                }
+                let mut yb = dense.eval(tb);
+                yb[1] = side * w;
+                // On the edge both modes give the same θ̈ (the torque is continuous): its sign
+                // says which side the motion goes on to. Were it tangent and no time gained,
+                // take the other mode anyway, or the step would repeat forever.
+                let a = model.accel_in(tb, yb[0], yb[1], dir, 0.0);
+                let next = if a * side > 0.0 { side } else { 0.0 };
+                gen = if next == gen && tb <= t {
+                    gen_flip(gen, side)
+                } else {
+                    next
+                };
+                t = tb;
+                y = yb;
+                need_k1 = true;
+                h = h_next.min(h);
+                continue;
+            }
+        }
         if crossing {
             let dense = dense();
             let te = locate_zero(&dense, t, t_new, dir);
@@ -642,6 +739,7 @@ where
             };
             t = te;
             y = ye;
+            gen = model.gen_mode(0.0);
             let (q, c) = model.static_balance(t, y[0]);
             if breaks_loose(q, c) && idle_events < 3 {
                 dir = q.signum();
@@ -681,8 +779,17 @@ where
 }
 
 #[inline]
-fn f(model: &Model, t: f64, y: Y, dir: f64) -> Y {
-    [y[1], model.accel(t, y[0], y[1], dir)]
+fn f(model: &Model, t: f64, y: Y, dir: f64, gen: f64) -> Y {
+    [y[1], model.accel_in(t, y[0], y[1], dir, gen)]
+}
+
+/// The generator's other mode on the edge of side `side`.
+fn gen_flip(gen: f64, side: f64) -> f64 {
+    if gen == 0.0 {
+        side
+    } else {
+        0.0
+    }
 }
 
 #[inline]
@@ -697,7 +804,13 @@ fn add(y: Y, h: f64, terms: &[(f64, Y)]) -> Y {
 
 /// Root of θ̇ on the dense output in (a, b], where θ̇·dir > 0 at a and ≤ 0 at b (Illinois).
 fn locate_zero(dense: &Dense, a: f64, b: f64, dir: f64) -> f64 {
-    let g = |t: f64| dense.eval(t)[1] * dir;
+    locate_level(dense, a, b, dir, 0.0)
+}
+
+/// Root of σθ̇ − κ on the dense output in (a, b], > 0 at a and ≤ 0 at b (Illinois). With κ = 0
+/// the same numbers as a plain sign test (x − 0 = x).
+fn locate_level(dense: &Dense, a: f64, b: f64, sigma: f64, kappa: f64) -> f64 {
+    let g = |t: f64| dense.eval(t)[1] * sigma - kappa;
     let (mut a, mut b) = (a, b);
     let (mut ga, mut gb) = (g(a), g(b));
     if ga <= 0.0 {
