@@ -466,13 +466,13 @@ fn generator_decay_loses_what_its_torque_works() {
         checked += 1;
     }
     assert!(checked > 20 && lost_total > 0.5, "lost {lost_total}");
-    // Once the peak speed is inside the band the generator takes nothing: the last swings keep
-    // their energy, and the peak speed ends where the band starts (from above).
-    let peak_last = tr.theta_dot[tr.t.len() - 4000..]
+    // The loss per swing vanishes as the peak speed nears the band's edge (it is
+    // ∝ (peak − w)^{3/2}): the peak speed creeps down to w from above, never below.
+    let peak_last = tr.theta_dot[tr.t.len() - 40_000..]
         .iter()
         .fold(0.0_f64, |a, v| a.max(v.abs()));
     assert!(
-        peak_last <= w && peak_last > 0.9 * w,
+        peak_last > w && peak_last < 1.3 * w,
         "last peak θ̇ {peak_last}"
     );
 }

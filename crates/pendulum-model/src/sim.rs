@@ -666,11 +666,24 @@ where
         let crossing = dir != 0.0 && y_new[1] * dir <= 0.0;
         // Did θ̇ cross the generator's dead-band edge? On: fell back to w on its side (or
         // below); off: left the band on either side.
+        // Off, θ̇ can also leave the band and come back within one step (a swing whose peak
+        // speed just exceeds w): when θ̈ changes sign in the step, θ̇'s extremum (where θ̈,
+        // interpolated linearly, vanishes) is checked on the dense output.
+        let mut band_until = t_new;
+        let mut band_speed = y_new[1];
         let band = gen_switch
             && if gen != 0.0 {
                 y_new[1] * gen <= model.params.gen_w
+            } else if y_new[1].abs() > model.params.gen_w {
+                true
+            } else if k1[1] * k7[1] < 0.0 {
+                let te = t + h * k1[1] / (k1[1] - k7[1]);
+                let v = dense().eval(te)[1];
+                band_until = te;
+                band_speed = v;
+                v.abs() > model.params.gen_w
             } else {
-                y_new[1].abs() > model.params.gen_w
+                false
             };
         if band {
             let dense = dense();
@@ -679,10 +692,10 @@ where
             let (side, sigma, kappa) = if gen != 0.0 {
                 (gen, gen, w)
             } else {
-                let side = y_new[1].signum();
+                let side = band_speed.signum();
                 (side, -side, -w)
             };
-            let tb = locate_level(&dense, t, t_new, sigma, kappa);
+            let tb = locate_level(&dense, t, band_until, sigma, kappa);
             // θ̇ = 0 (dry friction) can only come first from inside the band.
             let td = if crossing && gen == 0.0 {
                 locate_zero(&dense, t, t_new, dir)
