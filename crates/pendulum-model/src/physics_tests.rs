@@ -565,3 +565,27 @@ fn generator_takes_nothing_inside_its_dead_band() {
         "no loss above the band: {e_end}"
     );
 }
+
+/// A forced motion whose speed grazes the generator's band edge (θ̈ ≈ 0 at |θ̇| = w) with
+/// breakaway friction besides: cutting the step at an edge it starts on sent each mode to the
+/// other at no time gained (50 million steps at t = 602 before the graze rule). It must finish
+/// in a normal number of steps.
+#[test]
+fn generator_grazing_its_band_edge_is_no_zeno_loop() {
+    let mut d = Dimensionless::conservative();
+    (d.omega, d.r, d.lambda) = (1.3, 1.5, 0.126);
+    (d.beta, d.alpha, d.m_coulomb, d.base_load) = (0.03, 0.01, 0.004, true);
+    (d.c, d.s_break, d.v_break) = (0.002, 0.003, 0.1);
+    (d.p, d.k, d.phi_p, d.j) = (0.004, 3, 0.4, 0.05);
+    (d.gen_c, d.gen_w) = (0.04, 0.5);
+    let m = Model::new(d);
+    let opts = SimOptions {
+        max_steps: 200_000,
+        ..SimOptions::with_tol(1e-9)
+    };
+    let stats = integrate(&m, &opts, 0.0, [0.0, 3.0], 700.0, [700.0], |_| {
+        ControlFlow::Continue(())
+    })
+    .unwrap();
+    assert!(stats.band_events > 100 && stats.steps < 20_000, "{stats:?}");
+}

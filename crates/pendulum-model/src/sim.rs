@@ -172,10 +172,79 @@ impl Model {
         }
     }
 
+    /// The torques (per m g l) acting at (t, θ, θ̇), term by term, each signed as it acts on θ
+    /// (so a loss is opposite to θ̇): the power balance's terms. Not the integrator's path (that
+    /// is [`Model::accel`]); a test holds their sum to it. Dry friction acts in sgn θ̇ (0 at rest:
+    /// a stuck pendulum's friction does no work).
+    pub fn torques(&self, t: f64, theta: f64, theta_dot: f64) -> Torques {
+        let p = &self.params;
+        let (ay, ax) = self.base_accel(t);
+        let (s, c) = sin_cos(theta);
+        let dir = if theta_dot > 0.0 {
+            1.0
+        } else if theta_dot < 0.0 {
+            -1.0
+        } else {
+            0.0
+        };
+        let load = if p.base_load {
+            (theta_dot * theta_dot + (1.0 + ay) * c - ax * s).abs()
+        } else {
+            (theta_dot * theta_dot + c).abs()
+        };
+        let fading = if p.s_break != 0.0 {
+            let x = theta_dot / p.v_break;
+            p.s_break * (-x * x).exp()
+        } else {
+            0.0
+        };
+        let excess = (theta_dot.abs() - p.gen_w).max(0.0);
+        Torques {
+            gravity: -s,
+            base: -ay * s - ax * c,
+            viscous: -p.beta * theta_dot,
+            quadratic: -p.alpha * theta_dot * theta_dot.abs(),
+            dry: -(p.m_coulomb * load + p.c + fading) * dir,
+            generator: -p.gen_c * excess * dir,
+            position: -p.p * (p.k as f64 * theta + p.phi_p).sin(),
+            spring: -p.kappa * theta,
+        }
+    }
+
     /// Mechanical energy per m g l of the unforced pendulum: (1 + j) θ̇²/2 − cos θ + κθ²/2.
     pub fn energy(&self, theta: f64, theta_dot: f64) -> f64 {
         0.5 * (1.0 + self.params.j) * theta_dot * theta_dot - theta.cos()
             + 0.5 * self.params.kappa * theta * theta
+    }
+}
+
+/// The torques of [`Model::torques`], per m g l, each signed as it acts on θ; their sum is
+/// (1 + j) θ̈.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Torques {
+    /// Gravity, −sin θ.
+    pub gravity: f64,
+    /// The base's motion seen in the pendulum's frame, −A_y sin θ − A_x cos θ.
+    pub base: f64,
+    pub viscous: f64,
+    pub quadratic: f64,
+    /// Bearing (load-proportional), constant and fading (stribeck) dry friction.
+    pub dry: f64,
+    pub generator: f64,
+    pub position: f64,
+    pub spring: f64,
+}
+
+impl Torques {
+    pub fn sum(&self) -> f64 {
+        self.gravity
+            + self.base
+            + self.viscous
+            + self.quadratic
+            + self.dry
+            + self.generator
+            + self.position
+            + self.spring
     }
 }
 
@@ -670,6 +739,7 @@ where
         // speed just exceeds w): when θ̈ changes sign in the step, θ̇'s extremum (where θ̈,
         // interpolated linearly, vanishes) is checked on the dense output.
         let mut band_until = t_new;
+        let mut graze = false;
         let mut band_speed = y_new[1];
         let band = gen_switch
             && if gen != 0.0 {
@@ -702,7 +772,12 @@ where
             } else {
                 f64::INFINITY
             };
-            if tb < td {
+            // No time gained: the step starts on the edge and the motion grazes it (θ̈ ≈ 0
+            // there). Cutting would repeat forever (each mode sends it to the other); the step
+            // is taken whole instead, its mode error g·(|θ̇| − w) being as small as the graze,
+            // and the mode regraded from where it ends.
+            graze = tb <= t + 1e-12 * t.abs().max(1.0);
+            if tb < td && !graze {
                 stats.band_events += 1;
                 while let Some(&ts) = times.peek() {
                     if ts < tb {
@@ -715,15 +790,9 @@ where
                 let mut yb = dense.eval(tb);
                 yb[1] = side * w;
                 // On the edge both modes give the same θ̈ (the torque is continuous): its sign
-                // says which side the motion goes on to. Were it tangent and no time gained,
-                // take the other mode anyway, or the step would repeat forever.
+                // says which side the motion goes on to.
                 let a = model.accel_in(tb, yb[0], yb[1], dir, 0.0);
-                let next = if a * side > 0.0 { side } else { 0.0 };
-                gen = if next == gen && tb <= t {
-                    gen_flip(gen, side)
-                } else {
-                    next
-                };
+                gen = if a * side > 0.0 { side } else { 0.0 };
                 t = tb;
                 y = yb;
                 need_k1 = true;
@@ -783,6 +852,13 @@ where
         t = t_new;
         y = y_new;
         k1 = k7;
+        if graze {
+            let regraded = model.gen_mode(y[1]);
+            if regraded != gen {
+                gen = regraded;
+                need_k1 = true;
+            }
+        }
         if !last {
             h = h_next;
             stats.last_h = h;
@@ -794,15 +870,6 @@ where
 #[inline]
 fn f(model: &Model, t: f64, y: Y, dir: f64, gen: f64) -> Y {
     [y[1], model.accel_in(t, y[0], y[1], dir, gen)]
-}
-
-/// The generator's other mode on the edge of side `side`.
-fn gen_flip(gen: f64, side: f64) -> f64 {
-    if gen == 0.0 {
-        side
-    } else {
-        0.0
-    }
 }
 
 #[inline]
