@@ -78,6 +78,11 @@ impl Physical {
         self.m_kg * self.g_m_s2 * self.l_m
     }
 
+    /// Power scale m·g·l·ω0, W: dimensionless powers (torque per m g l × dθ/dt) times it.
+    pub fn power_scale_w(&self) -> f64 {
+        self.torque_scale_nm() * self.omega0_rad_s()
+    }
+
     /// Checks that every quantity is finite and in its physical range.
     pub fn validate(&self) -> Result<(), ModelError> {
         let positive = [
