@@ -130,7 +130,14 @@ impl Model {
     /// θ̈ while slipping in direction `dir` (±1; 0 when there is no dry friction).
     #[inline]
     pub fn accel(&self, t: f64, theta: f64, theta_dot: f64, dir: f64) -> f64 {
-        self.accel_in(t, theta, theta_dot, dir, self.gen_mode(theta_dot))
+        // The mode only matters with a generator; most models have none (and RK4 baselines
+        // call this per stage).
+        let gen = if self.params.gen_c != 0.0 {
+            self.gen_mode(theta_dot)
+        } else {
+            0.0
+        };
+        self.accel_in(t, theta, theta_dot, dir, gen)
     }
 
     /// θ̈ with the generator held in mode `gen` ([`Model::gen_mode`]): the integrator's smooth
