@@ -4,6 +4,7 @@
 pub mod effects;
 pub mod excitation;
 pub mod params;
+pub mod power;
 pub mod sim;
 pub mod spec;
 pub mod steady;
@@ -14,7 +15,8 @@ mod physics_tests;
 pub use effects::{Effect, EffectParam, Sensors, CATALOGUE};
 pub use excitation::{CrankDrive, CrankTable, Excitation, MeasuredAccel};
 pub use params::{Dimensionless, Effects, Physical};
-pub use sim::{integrate, simulate, Model, Sample, SimOptions, SimStats, Trajectory};
+pub use power::{mean_powers, MeanPowers};
+pub use sim::{integrate, simulate, Model, Sample, SimOptions, SimStats, Torques, Trajectory};
 pub use spec::ParamSpec;
 pub use steady::{
     classify_history, classify_poincare, ClassifyOptions, PartialClass, SteadyClass, SteadyState,

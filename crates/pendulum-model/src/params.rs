@@ -5,6 +5,7 @@
 //!
 //! ```text
 //! (1 + j) θ̈ = −(1 + A_y) sin θ − A_x cos θ − β θ̇ − α θ̇|θ̇| − (M·N + c) sgn θ̇ − p sin(kθ + φ_p)
+//!              − g (|θ̇| − w)⁺ sgn θ̇
 //! ```
 //!
 //! with A_y = ÿ/g, A_x = ẍ/g, N = |θ̇² + cos θ| (reference) or |θ̇² + (1 + A_y) cos θ − A_x sin θ|
@@ -75,6 +76,11 @@ impl Physical {
     /// Torque scale m·g·l, N·m: dimensionless torques are SI torques divided by it.
     pub fn torque_scale_nm(&self) -> f64 {
         self.m_kg * self.g_m_s2 * self.l_m
+    }
+
+    /// Power scale m·g·l·ω0, W: dimensionless powers (torque per m g l × dθ/dt) times it.
+    pub fn power_scale_w(&self) -> f64 {
+        self.torque_scale_nm() * self.omega0_rad_s()
     }
 
     /// Checks that every quantity is finite and in its physical range.
@@ -205,6 +211,13 @@ pub struct Dimensionless {
     pub s_break: f64,
     #[serde(default)]
     pub v_break: f64,
+    /// Torque with a dead band, g·(|θ̇| − w)⁺ sgn θ̇ (a generator through a rectifier): its slope
+    /// g = c_g ω0/(m g l) and dead-band speed w = ω_d/ω0 (both ≥ 0). Zero at rest, so it never
+    /// enters the sticking capacity. Absent = 0.
+    #[serde(default)]
+    pub gen_c: f64,
+    #[serde(default)]
+    pub gen_w: f64,
     /// Linear restoring stiffness κ = k/(m g l) of a torque −k θ besides gravity (a torsion
     /// spring, a cable): free decays of spring-loaded pendulums (issue 16). Absent = 0.
     #[serde(default)]
@@ -237,6 +250,8 @@ impl Dimensionless {
             omega_drift: 0.0,
             s_break: 0.0,
             v_break: 0.0,
+            gen_c: 0.0,
+            gen_w: 0.0,
             kappa: 0.0,
         }
     }
@@ -268,6 +283,8 @@ impl Dimensionless {
                 self.v_break,
                 self.v_break >= 0.0 && (self.s_break == 0.0 || self.v_break > 0.0),
             ),
+            ("gen_c", self.gen_c, self.gen_c >= 0.0),
+            ("gen_w", self.gen_w, self.gen_w >= 0.0),
         ];
         for (name, v, ok) in checks {
             if !(v.is_finite() && ok) {

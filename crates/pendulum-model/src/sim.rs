@@ -10,6 +10,13 @@
 //! output. At the event the applied torque Q (everything but friction, at θ̇ = 0) is compared with
 //! the static capacity C = M·N + c + s: |Q| ≤ C → stick (θ̇ = 0 exactly, θ fixed) until
 //! |Q(t)| > C(t); otherwise slip in direction sgn Q.
+//!
+//! A generator behind a rectifier, g·(|θ̇| − w)⁺ sgn θ̇, is a second switching surface, |θ̇| = w:
+//! the torque is continuous there but its slope is not, and a step straddling the kink loses
+//! DOPRI5's order (its error estimate no longer measures its error). So it is handled like
+//! θ̇ = 0: within a step the generator is in a fixed mode (off, or on on one side, where its term
+//! is the smooth g·(θ̇ ∓ w)), and a step that ends on the other side of the surface is cut at the
+//! crossing, located on the dense output.
 
 use std::ops::ControlFlow;
 use std::sync::Arc;
@@ -106,9 +113,37 @@ impl Model {
         (q, p.m_coulomb * load + p.c + p.s_break)
     }
 
+    /// The generator's mode at θ̇: ±1 on (beyond the dead band on that side), 0 off (inside it).
+    /// Without a dead band (w = 0) its term g·θ̇ is smooth: always "on" with sign 1.
+    #[inline]
+    pub fn gen_mode(&self, theta_dot: f64) -> f64 {
+        let w = self.params.gen_w;
+        if w == 0.0 || theta_dot > w {
+            1.0
+        } else if theta_dot < -w {
+            -1.0
+        } else {
+            0.0
+        }
+    }
+
     /// θ̈ while slipping in direction `dir` (±1; 0 when there is no dry friction).
     #[inline]
     pub fn accel(&self, t: f64, theta: f64, theta_dot: f64, dir: f64) -> f64 {
+        // The mode only matters with a generator; most models have none (and RK4 baselines
+        // call this per stage).
+        let gen = if self.params.gen_c != 0.0 {
+            self.gen_mode(theta_dot)
+        } else {
+            0.0
+        };
+        self.accel_in(t, theta, theta_dot, dir, gen)
+    }
+
+    /// θ̈ with the generator held in mode `gen` ([`Model::gen_mode`]): the integrator's smooth
+    /// right-hand side within a step.
+    #[inline(always)]
+    fn accel_in(&self, t: f64, theta: f64, theta_dot: f64, dir: f64, gen: f64) -> f64 {
         let p = &self.params;
         let (ay, ax) = self.base_accel(t);
         let (s, c) = sin_cos(theta);
@@ -129,6 +164,10 @@ impl Model {
             }
             q -= dry * dir;
         }
+        // Tested first: most models have no generator, and those that do spend time in its band.
+        if p.gen_c != 0.0 && gen != 0.0 {
+            q -= p.gen_c * (theta_dot - gen * p.gen_w);
+        }
         if p.p != 0.0 {
             q -= p.p * (p.k as f64 * theta + p.phi_p).sin();
         }
@@ -140,10 +179,79 @@ impl Model {
         }
     }
 
+    /// The torques (per m g l) acting at (t, θ, θ̇), term by term, each signed as it acts on θ
+    /// (so a loss is opposite to θ̇): the power balance's terms. Not the integrator's path (that
+    /// is [`Model::accel`]); a test holds their sum to it. Dry friction acts in sgn θ̇ (0 at rest:
+    /// a stuck pendulum's friction does no work).
+    pub fn torques(&self, t: f64, theta: f64, theta_dot: f64) -> Torques {
+        let p = &self.params;
+        let (ay, ax) = self.base_accel(t);
+        let (s, c) = sin_cos(theta);
+        let dir = if theta_dot > 0.0 {
+            1.0
+        } else if theta_dot < 0.0 {
+            -1.0
+        } else {
+            0.0
+        };
+        let load = if p.base_load {
+            (theta_dot * theta_dot + (1.0 + ay) * c - ax * s).abs()
+        } else {
+            (theta_dot * theta_dot + c).abs()
+        };
+        let fading = if p.s_break != 0.0 {
+            let x = theta_dot / p.v_break;
+            p.s_break * (-x * x).exp()
+        } else {
+            0.0
+        };
+        let excess = (theta_dot.abs() - p.gen_w).max(0.0);
+        Torques {
+            gravity: -s,
+            base: -ay * s - ax * c,
+            viscous: -p.beta * theta_dot,
+            quadratic: -p.alpha * theta_dot * theta_dot.abs(),
+            dry: -(p.m_coulomb * load + p.c + fading) * dir,
+            generator: -p.gen_c * excess * dir,
+            position: -p.p * (p.k as f64 * theta + p.phi_p).sin(),
+            spring: -p.kappa * theta,
+        }
+    }
+
     /// Mechanical energy per m g l of the unforced pendulum: (1 + j) θ̇²/2 − cos θ + κθ²/2.
     pub fn energy(&self, theta: f64, theta_dot: f64) -> f64 {
         0.5 * (1.0 + self.params.j) * theta_dot * theta_dot - theta.cos()
             + 0.5 * self.params.kappa * theta * theta
+    }
+}
+
+/// The torques of [`Model::torques`], per m g l, each signed as it acts on θ; their sum is
+/// (1 + j) θ̈.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Torques {
+    /// Gravity, −sin θ.
+    pub gravity: f64,
+    /// The base's motion seen in the pendulum's frame, −A_y sin θ − A_x cos θ.
+    pub base: f64,
+    pub viscous: f64,
+    pub quadratic: f64,
+    /// Bearing (load-proportional), constant and fading (stribeck) dry friction.
+    pub dry: f64,
+    pub generator: f64,
+    pub position: f64,
+    pub spring: f64,
+}
+
+impl Torques {
+    pub fn sum(&self) -> f64 {
+        self.gravity
+            + self.base
+            + self.viscous
+            + self.quadratic
+            + self.dry
+            + self.generator
+            + self.position
+            + self.spring
     }
 }
 
@@ -274,6 +382,9 @@ pub struct SimStats {
     pub rhs_evals: u64,
     /// θ̇ = 0 events located.
     pub events: u64,
+    /// Crossings of the generator's dead-band edge |θ̇| = w located.
+    #[serde(default)]
+    pub band_events: u64,
     /// Times the pendulum stuck.
     pub sticks: u64,
     /// True if the integration ended stuck (θ̇ = 0 exactly).
@@ -434,6 +545,10 @@ where
     } else {
         dir = 0.0;
     }
+    // The generator's mode (see the module docs); it switches only where its dead band has an
+    // edge (w > 0).
+    let gen_switch = model.params.gen_c != 0.0 && model.params.gen_w > 0.0;
+    let mut gen = model.gen_mode(y[1]);
     // Events that made no progress in a row (a guard against Zeno behaviour).
     let mut idle_events = 0u32;
     let mut h = opts
@@ -476,6 +591,7 @@ where
                     t = tb;
                     let (q, _) = model.static_balance(t, y[0]);
                     dir = q.signum();
+                    gen = model.gen_mode(0.0);
                     stuck = false;
                     need_k1 = true;
                     h = h.min(1e-2);
@@ -490,7 +606,7 @@ where
             });
         }
         if need_k1 {
-            k1 = f(model, t, y, dir);
+            k1 = f(model, t, y, dir, gen);
             stats.rhs_evals += 1;
             need_k1 = false;
         }
@@ -499,18 +615,20 @@ where
             h = t_end - t;
         }
         // One DOPRI5 step.
-        let k2 = f(model, t + dp::C2 * h, add(y, h, &[(dp::A21, k1)]), dir);
+        let k2 = f(model, t + dp::C2 * h, add(y, h, &[(dp::A21, k1)]), dir, gen);
         let k3 = f(
             model,
             t + dp::C3 * h,
             add(y, h, &[(dp::A31, k1), (dp::A32, k2)]),
             dir,
+            gen,
         );
         let k4 = f(
             model,
             t + dp::C4 * h,
             add(y, h, &[(dp::A41, k1), (dp::A42, k2), (dp::A43, k3)]),
             dir,
+            gen,
         );
         let k5 = f(
             model,
@@ -521,6 +639,7 @@ where
                 &[(dp::A51, k1), (dp::A52, k2), (dp::A53, k3), (dp::A54, k4)],
             ),
             dir,
+            gen,
         );
         let y6 = add(
             y,
@@ -533,7 +652,7 @@ where
                 (dp::A65, k5),
             ],
         );
-        let k6 = f(model, t + h, y6, dir);
+        let k6 = f(model, t + h, y6, dir, gen);
         let y_new = add(
             y,
             h,
@@ -545,7 +664,7 @@ where
                 (dp::A76, k6),
             ],
         );
-        let k7 = f(model, t + h, y_new, dir);
+        let k7 = f(model, t + h, y_new, dir, gen);
         stats.rhs_evals += 6;
         let mut err = 0.0;
         for i in 0..2 {
@@ -621,6 +740,73 @@ where
         let t_new = if last { t_end } else { t + h };
         // Did θ̇ reach zero against the slip direction?
         let crossing = dir != 0.0 && y_new[1] * dir <= 0.0;
+        // Did θ̇ cross the generator's dead-band edge? On: fell back to w on its side (or
+        // below); off: left the band on either side.
+        // Off, θ̇ can also leave the band and come back within one step (a swing whose peak
+        // speed just exceeds w): when θ̈ changes sign in the step, θ̇'s extremum (where θ̈,
+        // interpolated linearly, vanishes) is checked on the dense output.
+        let mut band_until = t_new;
+        let mut graze = false;
+        let mut band_speed = y_new[1];
+        let band = gen_switch
+            && if gen != 0.0 {
+                y_new[1] * gen <= model.params.gen_w
+            } else if y_new[1].abs() > model.params.gen_w {
+                true
+            } else if k1[1] * k7[1] < 0.0 {
+                let te = t + h * k1[1] / (k1[1] - k7[1]);
+                let v = dense().eval(te)[1];
+                band_until = te;
+                band_speed = v;
+                v.abs() > model.params.gen_w
+            } else {
+                false
+            };
+        if band {
+            let dense = dense();
+            let w = model.params.gen_w;
+            // g(t) = σθ̇ − κ, > 0 at t and ≤ 0 at the crossing.
+            let (side, sigma, kappa) = if gen != 0.0 {
+                (gen, gen, w)
+            } else {
+                let side = band_speed.signum();
+                (side, -side, -w)
+            };
+            let tb = locate_level(&dense, t, band_until, sigma, kappa);
+            // θ̇ = 0 (dry friction) can only come first from inside the band.
+            let td = if crossing && gen == 0.0 {
+                locate_zero(&dense, t, t_new, dir)
+            } else {
+                f64::INFINITY
+            };
+            // No time gained: the step starts on the edge and the motion grazes it (θ̈ ≈ 0
+            // there). Cutting would repeat forever (each mode sends it to the other); the step
+            // is taken whole instead, its mode error g·(|θ̇| − w) being as small as the graze,
+            // and the mode regraded from where it ends.
+            graze = tb <= t + 1e-12 * t.abs().max(1.0);
+            if tb < td && !graze {
+                stats.band_events += 1;
+                while let Some(&ts) = times.peek() {
+                    if ts < tb {
+                        times.next();
+                        emit!(ts, dense.eval(ts));
+                    } else {
+                        break;
+                    }
+                }
+                let mut yb = dense.eval(tb);
+                yb[1] = side * w;
+                // On the edge both modes give the same θ̈ (the torque is continuous): its sign
+                // says which side the motion goes on to.
+                let a = model.accel_in(tb, yb[0], yb[1], dir, 0.0);
+                gen = if a * side > 0.0 { side } else { 0.0 };
+                t = tb;
+                y = yb;
+                need_k1 = true;
+                h = h_next.min(h);
+                continue;
+            }
+        }
         if crossing {
             let dense = dense();
             let te = locate_zero(&dense, t, t_new, dir);
@@ -642,6 +828,7 @@ where
             };
             t = te;
             y = ye;
+            gen = model.gen_mode(0.0);
             let (q, c) = model.static_balance(t, y[0]);
             if breaks_loose(q, c) && idle_events < 3 {
                 dir = q.signum();
@@ -672,6 +859,13 @@ where
         t = t_new;
         y = y_new;
         k1 = k7;
+        if graze {
+            let regraded = model.gen_mode(y[1]);
+            if regraded != gen {
+                gen = regraded;
+                need_k1 = true;
+            }
+        }
         if !last {
             h = h_next;
             stats.last_h = h;
@@ -681,8 +875,8 @@ where
 }
 
 #[inline]
-fn f(model: &Model, t: f64, y: Y, dir: f64) -> Y {
-    [y[1], model.accel(t, y[0], y[1], dir)]
+fn f(model: &Model, t: f64, y: Y, dir: f64, gen: f64) -> Y {
+    [y[1], model.accel_in(t, y[0], y[1], dir, gen)]
 }
 
 #[inline]
@@ -697,7 +891,13 @@ fn add(y: Y, h: f64, terms: &[(f64, Y)]) -> Y {
 
 /// Root of θ̇ on the dense output in (a, b], where θ̇·dir > 0 at a and ≤ 0 at b (Illinois).
 fn locate_zero(dense: &Dense, a: f64, b: f64, dir: f64) -> f64 {
-    let g = |t: f64| dense.eval(t)[1] * dir;
+    locate_level(dense, a, b, dir, 0.0)
+}
+
+/// Root of σθ̇ − κ on the dense output in (a, b], > 0 at a and ≤ 0 at b (Illinois). With κ = 0
+/// the same numbers as a plain sign test (x − 0 = x).
+fn locate_level(dense: &Dense, a: f64, b: f64, sigma: f64, kappa: f64) -> f64 {
+    let g = |t: f64| dense.eval(t)[1] * sigma - kappa;
     let (mut a, mut b) = (a, b);
     let (mut ga, mut gb) = (g(a), g(b));
     if ga <= 0.0 {

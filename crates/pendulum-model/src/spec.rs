@@ -96,7 +96,14 @@ impl ParamSpec {
     /// Applies the physical and effect keys to `p` in order (no validation, no dimensionless
     /// keys): the survey's designs are built with it.
     pub fn apply_physical(&self, p: &mut Physical) -> Result<(), ModelError> {
+        // Another form of an effect's parameters (the generator's k_e, V_d, R) is converted
+        // once all of it is read, after the rest.
+        let mut alternatives: Vec<(&str, f64)> = Vec::new();
         for (k, v) in &self.assignments {
+            if crate::effects::alternative_key(k).is_some() {
+                alternatives.push((k.as_str(), *v));
+                continue;
+            }
             let v = *v;
             let k = ALIASES
                 .iter()
@@ -119,7 +126,8 @@ impl ParamSpec {
                 }
             }
         }
-        Ok(())
+        let own: Vec<&str> = self.assignments.iter().map(|(k, _)| k.as_str()).collect();
+        crate::effects::apply_alternatives(p, &alternatives, &own)
     }
 
     /// Resolves onto `base` (see the module docs). Returns the physical set (with the

@@ -27,6 +27,7 @@ mod coulomb_bearing;
 mod coulomb_constant;
 mod encoder_offset;
 mod extra_inertia;
+mod generator_rectified;
 mod horizontal_base;
 mod position_torque;
 mod speed_drift;
@@ -43,6 +44,7 @@ pub static CATALOGUE: &[&dyn Effect] = &[
     &coulomb_constant::CoulombConstant,
     &position_torque::PositionTorque,
     &stribeck::Stribeck,
+    &generator_rectified::GeneratorRectified,
     &horizontal_base::HorizontalBase,
     &extra_inertia::ExtraInertia,
     &encoder_offset::EncoderOffset,
@@ -133,6 +135,17 @@ impl Param {
     }
 }
 
+/// Another way to give an effect's parameters, converted to its own on reading (the
+/// generator's electrical k_e, V_d, R for its c_g, ω_d). Given in full or not at all, and never
+/// together with the effect's own parameters (`--param` and TOML alike).
+#[derive(Debug, Clone, Copy)]
+pub struct Alternative {
+    /// Its parameters: `--param` key, serialized field (inside the effect's table), SI unit.
+    pub params: &'static [Param],
+    /// Their values (in `params`' order) → the effect's own, or what is wrong with them.
+    pub convert: fn(&[f64]) -> Result<Vec<f64>, String>,
+}
+
 /// What [`Effect::decompile`] finds in the coefficients.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Decompiled {
@@ -155,6 +168,11 @@ pub trait Effect: Sync + std::fmt::Debug {
     fn term(&self) -> &'static str;
     /// The survey's design for this effect hidden alone.
     fn survey(&self) -> Survey;
+
+    /// Another way to give its parameters (see [`Alternative`]); stored and written in its own.
+    fn alternative(&self) -> Option<&'static Alternative> {
+        None
+    }
 
     /// Whether its values live in [`Physical`] itself (the reference model's a, b, μ) rather
     /// than in [`Effects`].
@@ -455,6 +473,45 @@ impl<'de> Deserialize<'de> for Effects {
             let ps = e.params();
             // `null`: absent (truth files list every effect).
             let Some(value) = value else { continue };
+            let value = match (value, e.alternative()) {
+                (Raw::Table(t), Some(alt))
+                    if alt.params.iter().any(|q| t.contains_key(q.field)) =>
+                {
+                    let own: Vec<&str> = ps.iter().map(|q| q.field).collect();
+                    let other: Vec<&str> = alt.params.iter().map(|q| q.field).collect();
+                    let both_forms = || {
+                        format!(
+                            "{key}: give either {} or {}, not both",
+                            own.join(", "),
+                            other.join(", ")
+                        )
+                    };
+                    if let Some(extra) = t.keys().find(|k| !other.contains(&k.as_str())) {
+                        return Err(D::Error::custom(if own.contains(&extra.as_str()) {
+                            both_forms()
+                        } else {
+                            format!(
+                                "{key}: unknown field {extra:?}: expected {} or {}",
+                                own.join(", "),
+                                other.join(", ")
+                            )
+                        }));
+                    }
+                    let mut v = Vec::with_capacity(other.len());
+                    for f in &other {
+                        v.push(*t.get(*f).ok_or_else(|| {
+                            D::Error::custom(format!(
+                                "{key}: missing field {f:?} (given as {})",
+                                other.join(", ")
+                            ))
+                        })?);
+                    }
+                    let own_values =
+                        (alt.convert)(&v).map_err(|m| D::Error::custom(format!("{key}: {m}")))?;
+                    Raw::Table(own.iter().map(|f| f.to_string()).zip(own_values).collect())
+                }
+                (value, _) => value,
+            };
             let vals = match (value, ps.len()) {
                 (Raw::Switch(on), 0) => on.then(Vec::new),
                 (Raw::Number(v), 1) => Some(vec![v]),
@@ -522,8 +579,71 @@ pub fn param_keys() -> Vec<&'static str> {
             out.push(switch_key(*e));
         }
         out.extend(e.params().iter().map(|p| p.key).filter(|k| k.contains('.')));
+        if let Some(alt) = e.alternative() {
+            out.extend(alt.params.iter().map(|p| p.key));
+        }
     }
     out
+}
+
+/// The effect whose [`Alternative`] has `--param` key `key`, and the key's position in it.
+pub fn alternative_key(key: &str) -> Option<(&'static dyn Effect, usize)> {
+    CATALOGUE.iter().copied().find_map(|e| {
+        let i = e.alternative()?.params.iter().position(|p| p.key == key)?;
+        Some((e, i))
+    })
+}
+
+/// Applies the [`Alternative`] assignments of one `--param` list to `p`, effect by effect:
+/// `given` holds (key, value) in order (the last of a repeated key wins), `own_given` the
+/// effect's own keys the same list assigns. Refuses both forms at once and an incomplete one.
+pub fn apply_alternatives(
+    p: &mut Physical,
+    given: &[(&str, f64)],
+    own_given: &[&str],
+) -> Result<(), ModelError> {
+    for e in CATALOGUE {
+        let Some(alt) = e.alternative() else { continue };
+        let mut vals: Vec<Option<f64>> = vec![None; alt.params.len()];
+        for (k, v) in given {
+            if let Some(i) = alt.params.iter().position(|q| q.key == *k) {
+                vals[i] = Some(*v);
+            }
+        }
+        if vals.iter().all(Option::is_none) {
+            continue;
+        }
+        let own: Vec<&str> = e.params().iter().map(|q| q.key).collect();
+        let other: Vec<&str> = alt.params.iter().map(|q| q.key).collect();
+        if let Some(k) = own_given.iter().find(|k| own.contains(k)) {
+            return Err(ModelError::BadInput(format!(
+                "{}: {k} given together with {}: give either {} or {}, not both",
+                e.name(),
+                other.join(", "),
+                own.join(", "),
+                other.join(", ")
+            )));
+        }
+        let missing: Vec<&str> = other
+            .iter()
+            .zip(&vals)
+            .filter(|(_, v)| v.is_none())
+            .map(|(k, _)| *k)
+            .collect();
+        if !missing.is_empty() {
+            return Err(ModelError::BadInput(format!(
+                "{}: {} missing (its parameters given as {} need all of them)",
+                e.name(),
+                missing.join(", "),
+                other.join(", ")
+            )));
+        }
+        let v: Vec<f64> = vals.into_iter().flatten().collect();
+        let own_values =
+            (alt.convert)(&v).map_err(|m| ModelError::BadInput(format!("{}: {m}", e.name())))?;
+        e.set(p, Some(&own_values));
+    }
+    Ok(())
 }
 
 /// The `--param` key of a switch: `name.on`.
@@ -642,11 +762,16 @@ pub fn markdown_table() -> String {
         let params = if e.params().is_empty() {
             format!("`{}` (switch)", switch_key(*e))
         } else {
-            e.params()
-                .iter()
-                .map(|p| format!("`{}` {}", p.key, p.unit))
-                .collect::<Vec<_>>()
-                .join(", ")
+            let list = |ps: &[Param]| {
+                ps.iter()
+                    .map(|p| format!("`{}` {}", p.key, p.unit))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            };
+            match e.alternative() {
+                None => list(e.params()),
+                Some(alt) => format!("{}; or {}", list(e.params()), list(alt.params)),
+            }
         };
         s.push_str(&format!(
             "| `{}` | {} | {} | {} | {} |\n",
