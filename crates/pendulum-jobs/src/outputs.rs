@@ -14,7 +14,7 @@ use parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
 use pendulum_model::Effects;
 use pendulum_plot::{Figure, Panel, Series, SeriesStyle};
 use pendulum_process::fit::{FitParam, ModelSpec};
-use pendulum_process::identify::{FitOutcome, RunFit};
+use pendulum_process::identify::{FitOutcome, ResidualSeries, RunFit};
 use pendulum_process::pipeline::Context;
 use pendulum_process::{RigParams, Role};
 use pendulum_report::{Column, ColumnData, TableOptions};
@@ -775,34 +775,17 @@ pub fn write_outputs_checked(
             cvv[2].push(mean);
         }
         // The residual the fit minimised (mode `segments`), then the free run (mode `free_run`).
-        for (id, role, s, segments) in segment_residuals_of(ctx, m, val)? {
-            for (k, segment) in segments.iter().enumerate() {
-                rs_run.push(id.clone());
-                rs_model.push(m.spec.name.clone());
-                rs_role.push(role.as_str().to_string());
-                rs_mode.push("segments".to_string());
-                rs_segment.push(*segment as i64);
-                let v = [
-                    s.t[k],
-                    s.tau_s[k],
-                    s.theta_meas[k],
-                    s.theta_sim[k],
-                    s.theta_meas[k] - s.theta_sim[k],
-                    s.theta_dot_meas[k],
-                    s.theta_dot_sim[k],
-                ];
-                for (col, x) in rsv.iter_mut().zip(v) {
-                    col.push(x);
-                }
-            }
-        }
-        for (id, role, s) in residuals_of(ctx, m, val, 60.0)? {
+        let mut push_rows = |id: &str,
+                             role: Role,
+                             mode: &str,
+                             s: &ResidualSeries,
+                             segment: &dyn Fn(usize) -> i64| {
             for k in 0..s.t.len() {
-                rs_run.push(id.clone());
+                rs_run.push(id.to_string());
                 rs_model.push(m.spec.name.clone());
                 rs_role.push(role.as_str().to_string());
-                rs_mode.push("free_run".to_string());
-                rs_segment.push(-1);
+                rs_mode.push(mode.to_string());
+                rs_segment.push(segment(k));
                 let v = [
                     s.t[k],
                     s.tau_s[k],
@@ -816,6 +799,15 @@ pub fn write_outputs_checked(
                     col.push(x);
                 }
             }
+        };
+        for (id, role, s, segments) in segment_residuals_of(ctx, m, val)? {
+            push_rows(&id, role, "segments", &s, &|k| segments[k] as i64);
+        }
+        let free_runs = residuals_of(ctx, m, val, 60.0)?;
+        for (id, role, s) in &free_runs {
+            push_rows(id, *role, "free_run", s, &|_| -1);
+        }
+        for (id, role, s) in free_runs {
             let png = out_file(
                 out,
                 &format!("history_{}_{}.png", m.spec.name.replace('+', "_"), id),
