@@ -158,6 +158,9 @@ struct Correction {
     theta_off_rad: f64,
     /// Accelerometer lag, s: the forcing's t = 0 is the measured one minus Δ.
     delay_s: f64,
+    /// Accepted shapes of the shaped columns (`crate::weak::SHAPED`'s order), SI; 0: the
+    /// column's default.
+    shapes: [f64; crate::weak::SHAPED.len()],
 }
 
 /// The weak-form equation-error view of a campaign: its rows (with per-run zeroing-error
@@ -203,6 +206,11 @@ impl View {
             if !al.forcing_understood() {
                 rows.retain(|r| r.phase.is_nan());
             }
+            for (k, sh) in crate::weak::SHAPED.iter().enumerate() {
+                if correction.shapes[k] > 0.0 {
+                    crate::weak::set_shape(&mut rows, sh.col, correction.shapes[k]);
+                }
+            }
             for mut r in rows {
                 r.run = weak_runs.len();
                 weak.push(r);
@@ -218,17 +226,37 @@ impl View {
         // Weights from the residual variance of the whole catalogue's fit (so that a missing
         // effect's own torque does not count as noise and down-weight where it lives).
         {
-            let id_rows: Vec<WeakRow> = weak.iter().filter(|r| is_id(r)).cloned().collect();
-            let all: Vec<usize> = (0..=crate::weak::DELAY).chain(zero_cols.clone()).collect();
+            let mut id_rows: Vec<WeakRow> = weak.iter().filter(|r| is_id(r)).cloned().collect();
+            let all: Vec<usize> = (0..crate::weak::WIDTH).chain(zero_cols.clone()).collect();
             let base_cols: Vec<usize> = base
                 .columns()
                 .into_iter()
                 .chain(zero_cols.clone())
                 .collect();
+            // The shaped columns at their best shapes for this fit (a hidden generator's torque
+            // is not noise either); accepted shapes stay.
+            for (k, sh) in crate::weak::SHAPED.iter().enumerate() {
+                if correction.shapes[k] > 0.0 {
+                    continue;
+                }
+                if let Some((v, _)) = crate::screen::profile_shape(&id_rows, &all, sh.col) {
+                    crate::weak::set_shape(&mut id_rows, sh.col, v);
+                    crate::weak::set_shape(&mut weak, sh.col, v);
+                }
+            }
             if let Some(full) = ols(&id_rows, &all).or_else(|| ols(&id_rows, &base_cols)) {
                 let res = full.residuals(&weak);
                 crate::weak::set_weights(&mut weak, &res);
             }
+        }
+        // Back to the default shapes: a shape is the screen's to choose.
+        for (k, sh) in crate::weak::SHAPED.iter().enumerate() {
+            let v = if correction.shapes[k] > 0.0 {
+                correction.shapes[k]
+            } else {
+                sh.default
+            };
+            crate::weak::set_shape(&mut weak, sh.col, v);
         }
         let id_rows: Vec<WeakRow> = weak.iter().filter(|r| is_id(r)).cloned().collect();
         let val_rows: Vec<WeakRow> = weak
@@ -244,6 +272,13 @@ impl View {
             val_rows,
             correction,
         }
+    }
+
+    /// Writes a shape into the shaped column `col` of every row of the view.
+    fn set_shape(&mut self, col: usize, value: f64) {
+        crate::weak::set_shape(&mut self.weak, col, value);
+        crate::weak::set_shape(&mut self.id_rows, col, value);
+        crate::weak::set_shape(&mut self.val_rows, col, value);
     }
 
     /// Weighted squared equation error of the validate rows under `fit` (coefficients from the
@@ -348,6 +383,14 @@ fn to_si(c: &Candidate, fit: &crate::screen::Ols) -> (f64, f64, &'static str) {
             let (v, e) = first(crate::weak::DELAY);
             (v, e, "s")
         }
+        "stribeck" => {
+            let (v, e) = first(crate::weak::STRIBECK);
+            (v, e, "N·m")
+        }
+        "generator_rectified" => {
+            let (v, e) = first(crate::weak::GENERATOR);
+            (v, e, "N·m·s/rad")
+        }
         _ => (f64::NAN, f64::NAN, "-"),
     }
 }
@@ -427,6 +470,8 @@ pub fn physically_possible(effect: &str, estimate: f64) -> bool {
         | "coulomb_bearing"
         | "bearing_load_base_accel"
         | "coulomb_constant"
+        | "stribeck"
+        | "generator_rectified"
         | "extra_inertia" => estimate > 0.0,
         "encoder_offset" => estimate.abs() < std::f64::consts::PI,
         _ => estimate.is_finite(),
@@ -823,6 +868,23 @@ fn extend(
             news.push((FitParam::of("position_torque"), est));
             news.push((FitParam::of("position_torque.phi_p"), b.atan2(a)));
         }
+        // A shaped column's effect: its size and the shape the screen's profile found, both
+        // refitted (the size first: it is what is judged).
+        _ if c.shaped().is_some() => {
+            let sh = c.shaped().expect("checked");
+            if let (Some(e), Some(p)) = (
+                pendulum_model::effects::by_name(&c.effect),
+                FitParam::find(sh.key),
+            ) {
+                if let Some(size) = e.params().first().and_then(|q| FitParam::find(q.key)) {
+                    let lo = size.bounds().0;
+                    out.fixed
+                        .set(&c.effect, Some(vec![est.max(lo), c.shape]));
+                    news.push((size, est.max(lo)));
+                    news.push((p, c.shape));
+                }
+            }
+        }
         // One refitted parameter, started at the screen's estimate inside its catalogue range's
         // sign (a non-negative parameter never starts below 0).
         name => {
@@ -894,7 +956,7 @@ fn moving_runs(
 fn sets_sticking_capacity(effect: &str) -> bool {
     matches!(
         effect,
-        "coulomb_bearing" | "bearing_load_base_accel" | "coulomb_constant"
+        "coulomb_bearing" | "bearing_load_base_accel" | "coulomb_constant" | "stribeck"
     )
 }
 
@@ -1276,6 +1338,9 @@ pub fn discover(
     while let Some(sc) = next.take() {
         let c = &sc.candidate;
         let cols = with_candidate(&current_cols, c);
+        if let Some(sh) = c.shaped() {
+            view.set_shape(sh.col, c.shape);
+        }
         let Some(fit) = ols(&view.id_rows, &cols) else {
             break;
         };
@@ -1503,6 +1568,8 @@ pub fn discover(
                 "{}{}{}; trajectory refit {:.4e} {}; held-out equation-error fall {:.1} % (needed > {:.1} %); refit f_obj {:.4}; E_θ gain needed > {:.3} (held-out noise {:.3})",
                 if c.effect == "position_torque" {
                     format!("k = {}; ", c.k)
+                } else if let Some(sh) = c.shaped() {
+                    format!("{} = {:.4} (the screen's profile); ", sh.key, c.shape)
                 } else {
                     String::new()
                 },
@@ -1539,6 +1606,14 @@ pub fn discover(
                 row.note.push_str(&format!(
                     "; applied exactly to the equation-error view (refined estimate {est:.4e} {unit})"
                 ));
+            }
+        }
+        if accepted {
+            if let Some(k) = crate::weak::SHAPED
+                .iter()
+                .position(|sh| c.shaped().is_some_and(|s| s.col == sh.col))
+            {
+                correction.shapes[k] = c.shape;
             }
         }
         confirmed.push((c.effect.clone(), row.clone()));

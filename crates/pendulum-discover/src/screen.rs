@@ -9,7 +9,7 @@
 use pendulum_process::linalg::{inverse, solve};
 use serde::{Deserialize, Serialize};
 
-use crate::weak::{is_dynamics, WeakRow, DELAY, INERTIA, OFFSET};
+use crate::weak::{is_dynamics, set_shape, shaped, WeakRow, DELAY, INERTIA, OFFSET, SHAPED};
 
 /// The base models discover starts from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -53,6 +53,18 @@ pub struct Candidate {
     pub replaces: Option<usize>,
     /// position_torque harmonic.
     pub k: u32,
+    /// The shape parameter of a shaped column ([`crate::weak::SHAPED`]: stribeck's v_s, the
+    /// generator's ω_d), SI, as the screen's profile found it; NaN until profiled, 0 for
+    /// unshaped candidates.
+    #[serde(default)]
+    pub shape: f64,
+}
+
+impl Candidate {
+    /// The shaped column this candidate adds, if any.
+    pub fn shaped(&self) -> Option<&'static crate::weak::Shaped> {
+        self.add.iter().find_map(|&c| shaped(c))
+    }
 }
 
 /// The candidates for a base model.
@@ -63,6 +75,7 @@ pub fn candidates(base: Base) -> Vec<Candidate> {
         add,
         replaces: None,
         k: 0,
+        shape: 0.0,
     };
     if base == Base::Linear {
         out.push(cand("viscous_quadratic", vec![1]));
@@ -78,6 +91,7 @@ pub fn candidates(base: Base) -> Vec<Candidate> {
             add: vec![3],
             replaces: Some(2),
             k: 0,
+            shape: 0.0,
         });
     }
     out.push(cand("coulomb_constant", vec![4]));
@@ -88,6 +102,13 @@ pub fn candidates(base: Base) -> Vec<Candidate> {
             add: vec![i, i + 1],
             replaces: None,
             k,
+            shape: 0.0,
+        });
+    }
+    for sh in &SHAPED {
+        out.push(Candidate {
+            shape: f64::NAN,
+            ..cand(sh.effect, vec![sh.col])
         });
     }
     out.push(cand("horizontal_base", vec![13]));
@@ -333,16 +354,85 @@ pub fn with_candidate(base_cols: &[usize], c: &Candidate) -> Vec<usize> {
     cols
 }
 
-/// ΔBIC of every candidate against `current` columns.
+/// The shape (SI) of the shaped column `col` that fits `rows` best with `columns` (which hold
+/// `col`), and that fit: the profile over the column's grid, refined by golden sections
+/// (in the logarithm of the shape) between the best point's neighbours. The rows are copied:
+/// the caller's keep their shape.
+pub fn profile_shape(rows: &[WeakRow], columns: &[usize], col: usize) -> Option<(f64, Ols)> {
+    let sh = shaped(col)?;
+    let mut trial = rows.to_vec();
+    let mut at = |v: f64| -> Option<Ols> {
+        set_shape(&mut trial, col, v);
+        ols(&trial, columns)
+    };
+    let grid = sh.grid;
+    let rss: Vec<f64> = grid
+        .iter()
+        .map(|&v| at(v).map_or(f64::INFINITY, |f| f.rss))
+        .collect();
+    let (ib, _) = rss
+        .iter()
+        .enumerate()
+        .filter(|(_, r)| r.is_finite())
+        .min_by(|a, b| a.1.total_cmp(b.1))?;
+    let (mut lo, mut hi) = (
+        grid[ib.saturating_sub(1)].ln(),
+        grid[(ib + 1).min(grid.len() - 1)].ln(),
+    );
+    let g = 0.5 * (5f64.sqrt() - 1.0);
+    let mut cost = |u: f64| at(u.exp()).map_or(f64::INFINITY, |f| f.rss);
+    let (mut a, mut b) = (hi - g * (hi - lo), lo + g * (hi - lo));
+    let (mut fa, mut fb) = (cost(a), cost(b));
+    for _ in 0..24 {
+        if fa < fb {
+            hi = b;
+            b = a;
+            fb = fa;
+            a = hi - g * (hi - lo);
+            fa = cost(a);
+        } else {
+            lo = a;
+            a = b;
+            fa = fb;
+            b = lo + g * (hi - lo);
+            fb = cost(b);
+        }
+    }
+    let mut best = (grid[ib], rss[ib]);
+    for (u, f) in [(a, fa), (b, fb)] {
+        if f < best.1 {
+            best = (u.exp(), f);
+        }
+    }
+    Some((best.0, at(best.0)?))
+}
+
+/// ΔBIC of every candidate against `current` columns. A shaped candidate is profiled over its
+/// shape first ([`profile_shape`]); its shape counts as one more parameter in the BIC. A
+/// candidate whose columns are all in `current` already is not screened (its shaped column
+/// holds an accepted shape that must not move).
 pub fn screen(rows: &[WeakRow], current: &[usize], cands: &[Candidate]) -> Vec<Screened> {
     let Some(base) = ols(rows, current) else {
         return Vec::new();
     };
     let b0 = base.bic();
+    let ln_n = (base.n.max(1) as f64).ln();
     let mut out: Vec<Screened> = cands
         .iter()
+        .filter(|c| c.replaces.is_some() || c.add.iter().any(|a| !current.contains(a)))
         .filter_map(|c| {
             let cols = with_candidate(current, c);
+            if let Some(sh) = c.shaped() {
+                let (shape, fit) = profile_shape(rows, &cols, sh.col)?;
+                return Some(Screened {
+                    candidate: Candidate {
+                        shape,
+                        ..c.clone()
+                    },
+                    delta_bic: fit.bic() - b0 + ln_n,
+                    fit,
+                });
+            }
             let fit = ols(rows, &cols)?;
             Some(Screened {
                 candidate: c.clone(),
@@ -455,6 +545,7 @@ mod tests {
             weight: 1.0,
             bob_inertia_kg_m2: bob,
             lib: Vec::new(),
+            speeds: Default::default(),
         }
     }
 

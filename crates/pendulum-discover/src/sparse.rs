@@ -454,7 +454,11 @@ pub fn describe(
 /// the measured acceleration, which the library does not).
 pub fn family_of(effect: &str) -> &'static [Variable] {
     match effect {
-        "viscous_linear" | "viscous_quadratic" | "coulomb_constant" => &[Variable::Rate],
+        "viscous_linear"
+        | "viscous_quadratic"
+        | "coulomb_constant"
+        | "stribeck"
+        | "generator_rectified" => &[Variable::Rate],
         "position_torque" | "extra_inertia" => &[Variable::Angle, Variable::AngleInTurn],
         _ => &[],
     }
@@ -621,6 +625,7 @@ mod tests {
             weight,
             bob_inertia_kg_m2: 1.0,
             lib: Vec::new(),
+            speeds: Default::default(),
         }
     }
 
