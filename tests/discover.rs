@@ -289,9 +289,14 @@ fn survey_issue_5_false_alarm_rate() {
         .unwrap_or(8);
     let mut r = rng(40);
     let (mut alarms, mut unexplained) = (0, 0);
+    // `SURVEY_ONE=fa:k` re-runs campaign k alone (`SURVEY_KEEP=DIR` keeps it).
+    let one = std::env::var("SURVEY_ONE").ok();
     for k in 0..n {
         let b = r.random_range(0.3..0.7);
         let mu = r.random_range(0.08..0.2);
+        if one.as_deref().is_some_and(|o| o != format!("fa:{k}")) {
+            continue;
+        }
         let s = discover(300 + k, Base::Reference, 0.0, b, mu, "");
         let accepted = s.discovery.accepted();
         alarms += usize::from(!accepted.is_empty());
@@ -388,16 +393,26 @@ fn regression_issue_5_finds_dry_torque_and_position_torque_together() {
 
 /// Issue 14: breakaway friction (`stribeck`) hidden alone on a drawn design is named alone,
 /// within 25 % of its T_s, and not mistaken for the constant dry torque it resembles at speed.
-/// Fails today (7.7 s): discover's screen (weak.rs TERMS, screen.rs candidates) does not take its
-/// columns from the catalogue yet, so stribeck is no candidate: nothing is named (every row
-/// screened out, held-out E_θ 5.5170 → 5.5170), coulomb_constant's screen estimate is 2.5e-5 N·m
-/// (interval −3.8e-4…4.3e-4, not named); only the free-segment envelopes show a dry torque
-/// (coulomb_constant 2.157e-3 N·m, truth T_s = 1.083e-2 N·m at v_s = 0.258 rad/s).
+/// Was a known failure while discover's screen had no stribeck column: nothing was named.
+/// The screen now profiles the breakaway's speed scale (`weak::SHAPED`).
 #[test]
-#[ignore = "known failure (issue 14): discover's screen has no stribeck column until weak.rs/screen.rs read the catalogue"]
 fn issue_14_finds_stribeck_and_tells_it_from_coulomb_constant() {
     let s = found_when_hidden("stribeck", 14_000, 14_001);
     assert!(!s.discovery.accepted().contains(&"coulomb_constant"));
+}
+
+/// Issue 15: a campaign recorded with a harvesting generator on the shaft (drawn load and dead
+/// band) names `generator_rectified` alone within 25 % of its c_g, and the extended model's
+/// refit carries both its load and its band.
+#[test]
+fn issue_15_finds_the_generator_when_hidden() {
+    let s = found_when_hidden("generator_rectified", 15_000, 15_001);
+    let ext = s.discovery.extended.as_ref().expect("an extended model");
+    let keys: Vec<&str> = ext.spec.params.iter().map(|p| p.name()).collect();
+    assert!(
+        keys.iter().any(|k| k.contains("omega_d")) && keys.iter().any(|k| k.contains("c_g")),
+        "{keys:?}"
+    );
 }
 
 /// A drawn size of one hidden effect: (truth in the diagnosis's unit, the twin's effects table

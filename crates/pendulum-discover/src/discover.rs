@@ -226,37 +226,19 @@ impl View {
         // Weights from the residual variance of the whole catalogue's fit (so that a missing
         // effect's own torque does not count as noise and down-weight where it lives).
         {
-            let mut id_rows: Vec<WeakRow> = weak.iter().filter(|r| is_id(r)).cloned().collect();
-            let all: Vec<usize> = (0..crate::weak::WIDTH).chain(zero_cols.clone()).collect();
+            // The shaped columns stay out: a shape is the screen's to choose, and a profile
+            // here moved every later step's weights (a hidden dry torque's refit with them).
+            let id_rows: Vec<WeakRow> = weak.iter().filter(|r| is_id(r)).cloned().collect();
+            let all: Vec<usize> = (0..=crate::weak::DELAY).chain(zero_cols.clone()).collect();
             let base_cols: Vec<usize> = base
                 .columns()
                 .into_iter()
                 .chain(zero_cols.clone())
                 .collect();
-            // The shaped columns at their best shapes for this fit (a hidden generator's torque
-            // is not noise either); accepted shapes stay.
-            for (k, sh) in crate::weak::SHAPED.iter().enumerate() {
-                if correction.shapes[k] > 0.0 {
-                    continue;
-                }
-                if let Some((v, _)) = crate::screen::profile_shape(&id_rows, &all, sh.col) {
-                    crate::weak::set_shape(&mut id_rows, sh.col, v);
-                    crate::weak::set_shape(&mut weak, sh.col, v);
-                }
-            }
             if let Some(full) = ols(&id_rows, &all).or_else(|| ols(&id_rows, &base_cols)) {
                 let res = full.residuals(&weak);
                 crate::weak::set_weights(&mut weak, &res);
             }
-        }
-        // Back to the default shapes: a shape is the screen's to choose.
-        for (k, sh) in crate::weak::SHAPED.iter().enumerate() {
-            let v = if correction.shapes[k] > 0.0 {
-                correction.shapes[k]
-            } else {
-                sh.default
-            };
-            crate::weak::set_shape(&mut weak, sh.col, v);
         }
         let id_rows: Vec<WeakRow> = weak.iter().filter(|r| is_id(r)).cloned().collect();
         let val_rows: Vec<WeakRow> = weak
@@ -878,8 +860,7 @@ fn extend(
             ) {
                 if let Some(size) = e.params().first().and_then(|q| FitParam::find(q.key)) {
                     let lo = size.bounds().0;
-                    out.fixed
-                        .set(&c.effect, Some(vec![est.max(lo), c.shape]));
+                    out.fixed.set(&c.effect, Some(vec![est.max(lo), c.shape]));
                     news.push((size, est.max(lo)));
                     news.push((p, c.shape));
                 }
@@ -1441,7 +1422,11 @@ pub fn discover(
             None => (f64::NAN, f64::INFINITY),
         };
         let eq_needed = cfg.eq_gain_min.max(eq_noise);
-        let ci = (est - 1.96 * se, est + 1.96 * se);
+        let mut ci = (est - 1.96 * se, est + 1.96 * se);
+        // A shaped effect's size is known only as well as its shape's profile allows.
+        if let Some((lo, hi)) = c.size_band.filter(|_| !nonlinear) {
+            ci = (ci.0.min(lo), ci.1.max(hi));
+        }
         let excludes_zero = ci.0 > 0.0 || ci.1 < 0.0;
         // Either held-out measure will do. On the equation error alone, E_θ may not rise by more than its own noise: near the
         // study's setting the validate runs' segments scatter by ±10–20 %, more than a dry torque
@@ -1499,7 +1484,12 @@ pub fn discover(
             };
             g >= -n && informative
         };
-        let agree = views_agree(est, 1.96 * se, refit_est, screen_fits_trajectories);
+        let agree = views_agree(
+            est,
+            (1.96 * se).max(est - ci.0).max(ci.1 - est),
+            refit_est,
+            screen_fits_trajectories,
+        );
         // A freer shape in the effect's own variable that does clearly better makes the
         // catalogue entry a partial explanation of a departure it does not describe.
         let partial = crate::sparse::family_beats_candidate(
@@ -1658,12 +1648,16 @@ pub fn discover(
             continue;
         }
         let (est, se, unit) = to_si(&sc.candidate, &sc.fit);
+        let (lo, hi) = sc
+            .candidate
+            .size_band
+            .unwrap_or((est - 1.96 * se, est + 1.96 * se));
         rows.push(DiagnosisRow {
             effect: sc.candidate.effect.clone(),
             accepted: false,
             estimate: est,
-            ci_low: est - 1.96 * se,
-            ci_high: est + 1.96 * se,
+            ci_low: lo.min(est - 1.96 * se),
+            ci_high: hi.max(est + 1.96 * se),
             unit: unit.into(),
             delta_bic: sc.delta_bic,
             heldout_gain: f64::NAN,

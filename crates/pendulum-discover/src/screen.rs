@@ -58,6 +58,10 @@ pub struct Candidate {
     /// unshaped candidates.
     #[serde(default)]
     pub shape: f64,
+    /// A shaped candidate's size interval over its shape's profile (see [`profile_shape`]):
+    /// the union of the 95 % intervals of the size at every shape the data do not reject.
+    #[serde(default)]
+    pub size_band: Option<(f64, f64)>,
 }
 
 impl Candidate {
@@ -76,6 +80,7 @@ pub fn candidates(base: Base) -> Vec<Candidate> {
         replaces: None,
         k: 0,
         shape: 0.0,
+        size_band: None,
     };
     if base == Base::Linear {
         out.push(cand("viscous_quadratic", vec![1]));
@@ -92,6 +97,7 @@ pub fn candidates(base: Base) -> Vec<Candidate> {
             replaces: Some(2),
             k: 0,
             shape: 0.0,
+            size_band: None,
         });
     }
     out.push(cand("coulomb_constant", vec![4]));
@@ -103,6 +109,7 @@ pub fn candidates(base: Base) -> Vec<Candidate> {
             replaces: None,
             k,
             shape: 0.0,
+            size_band: None,
         });
     }
     for sh in &SHAPED {
@@ -359,6 +366,21 @@ pub fn with_candidate(base_cols: &[usize], c: &Candidate) -> Vec<usize> {
 /// (in the logarithm of the shape) between the best point's neighbours. The rows are copied:
 /// the caller's keep their shape.
 pub fn profile_shape(rows: &[WeakRow], columns: &[usize], col: usize) -> Option<(f64, Ols)> {
+    profile_shape_band(rows, columns, col).map(|(v, f, _)| (v, f))
+}
+
+/// Likelihood-ratio bound of a profiled shape: n ln(RSS/RSS_min) under χ²₁'s 95 % point.
+const SHAPE_LR_95: f64 = 3.84;
+
+/// [`profile_shape`] with the size's interval over the shapes the data do not reject
+/// ([`SHAPE_LR_95`]): a size and its shape can trade (stribeck's breakaway acts for tens of
+/// ms at each turning point, and a window sees mostly T_s v_s²), so the size's own interval at
+/// the best shape understates what is known of it.
+pub fn profile_shape_band(
+    rows: &[WeakRow],
+    columns: &[usize],
+    col: usize,
+) -> Option<(f64, Ols, (f64, f64))> {
     let sh = shaped(col)?;
     let mut trial = rows.to_vec();
     let mut at = |v: f64| -> Option<Ols> {
@@ -366,21 +388,40 @@ pub fn profile_shape(rows: &[WeakRow], columns: &[usize], col: usize) -> Option<
         ols(&trial, columns)
     };
     let grid = sh.grid;
-    let rss: Vec<f64> = grid
+    // Only shapes at which the effect's size is physically possible (positive: it takes energy
+    // out) are candidates; a shape with the freedom to fit a negative breakaway or load found
+    // "impossible" departures in campaigns with nothing hidden. With none possible the column
+    // stays at its default shape and the candidate is judged there.
+    let possible = |f: &Ols| f.coef_of(col).is_some_and(|(v, _)| v > 0.0);
+    let fits: Vec<Option<Ols>> = grid.iter().map(|&v| at(v)).collect();
+    let rss: Vec<f64> = fits
         .iter()
-        .map(|&v| at(v).map_or(f64::INFINITY, |f| f.rss))
+        .map(|f| {
+            f.as_ref()
+                .filter(|f| possible(f))
+                .map_or(f64::INFINITY, |f| f.rss)
+        })
         .collect();
-    let (ib, _) = rss
+    let Some((ib, _)) = rss
         .iter()
         .enumerate()
         .filter(|(_, r)| r.is_finite())
-        .min_by(|a, b| a.1.total_cmp(b.1))?;
+        .min_by(|a, b| a.1.total_cmp(b.1))
+    else {
+        let fit = at(sh.default)?;
+        let (v, se) = fit.coef_of(col)?;
+        return Some((sh.default, fit, (v - 1.96 * se, v + 1.96 * se)));
+    };
     let (mut lo, mut hi) = (
         grid[ib.saturating_sub(1)].ln(),
         grid[(ib + 1).min(grid.len() - 1)].ln(),
     );
     let g = 0.5 * (5f64.sqrt() - 1.0);
-    let mut cost = |u: f64| at(u.exp()).map_or(f64::INFINITY, |f| f.rss);
+    let mut cost = |u: f64| {
+        at(u.exp())
+            .filter(|f| possible(f))
+            .map_or(f64::INFINITY, |f| f.rss)
+    };
     let (mut a, mut b) = (hi - g * (hi - lo), lo + g * (hi - lo));
     let (mut fa, mut fb) = (cost(a), cost(b));
     for _ in 0..24 {
@@ -404,7 +445,18 @@ pub fn profile_shape(rows: &[WeakRow], columns: &[usize], col: usize) -> Option<
             best = (u.exp(), f);
         }
     }
-    Some((best.0, at(best.0)?))
+    let fit = at(best.0)?;
+    let size = |f: &Ols| f.coef_of(col).map(|(v, se)| (v - 1.96 * se, v + 1.96 * se));
+    let mut band = size(&fit)?;
+    let n = fit.n as f64;
+    for f in fits.iter().flatten().filter(|f| possible(f)) {
+        if n * (f.rss / fit.rss).ln() <= SHAPE_LR_95 {
+            if let Some((lo, hi)) = size(f) {
+                band = (band.0.min(lo), band.1.max(hi));
+            }
+        }
+    }
+    Some((best.0, fit, band))
 }
 
 /// ΔBIC of every candidate against `current` columns. A shaped candidate is profiled over its
@@ -423,10 +475,11 @@ pub fn screen(rows: &[WeakRow], current: &[usize], cands: &[Candidate]) -> Vec<S
         .filter_map(|c| {
             let cols = with_candidate(current, c);
             if let Some(sh) = c.shaped() {
-                let (shape, fit) = profile_shape(rows, &cols, sh.col)?;
+                let (shape, fit, band) = profile_shape_band(rows, &cols, sh.col)?;
                 return Some(Screened {
                     candidate: Candidate {
                         shape,
+                        size_band: Some(band),
                         ..c.clone()
                     },
                     delta_bic: fit.bic() - b0 + ln_n,

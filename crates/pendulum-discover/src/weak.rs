@@ -744,7 +744,12 @@ mod shaped_tests {
             t_s * v_s * v_s
         );
         let constant = crate::screen::ols(&rows, &[2, 4]).unwrap();
-        assert!(constant.rss > 2.0 * fit.rss, "{} vs {}", constant.rss, fit.rss);
+        assert!(
+            constant.rss > 2.0 * fit.rss,
+            "{} vs {}",
+            constant.rss,
+            fit.rss
+        );
     }
 }
 
