@@ -152,15 +152,15 @@ impl Discovery {
 
 /// Exact corrections of the measured motion for accepted effects that enter the equation of
 /// motion nonlinearly.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
+#[derive(Debug, Clone, Default, PartialEq)]
 struct Correction {
     /// Encoder offset, rad: the view uses θ_meas − θ_off.
     theta_off_rad: f64,
     /// Accelerometer lag, s: the forcing's t = 0 is the measured one minus Δ.
     delay_s: f64,
-    /// Accepted shapes of the shaped columns (`crate::weak::SHAPED`'s order), SI; 0: the
-    /// column's default.
-    shapes: [f64; crate::weak::SHAPED.len()],
+    /// Accepted shapes of the shaped columns (by column, see `crate::weak::shaped_columns`),
+    /// SI; absent: the column's default.
+    shapes: std::collections::BTreeMap<usize, f64>,
 }
 
 /// The weak-form equation-error view of a campaign: its rows (with per-run zeroing-error
@@ -182,7 +182,7 @@ impl View {
         alignments: &std::collections::BTreeMap<String, pendulum_process::Alignment>,
         base: Base,
         cfg: &WeakConfig,
-        correction: Correction,
+        correction: &Correction,
     ) -> View {
         let mut weak = Vec::new();
         let mut weak_runs = Vec::new();
@@ -206,10 +206,8 @@ impl View {
             if !al.forcing_understood() {
                 rows.retain(|r| r.phase.is_nan());
             }
-            for (k, sh) in crate::weak::SHAPED.iter().enumerate() {
-                if correction.shapes[k] > 0.0 {
-                    crate::weak::set_shape(&mut rows, sh.col, correction.shapes[k]);
-                }
+            for (&col, &v) in &correction.shapes {
+                crate::weak::set_shape(&mut rows, col, v);
             }
             for mut r in rows {
                 r.run = weak_runs.len();
@@ -252,7 +250,7 @@ impl View {
             zero_cols,
             id_rows,
             val_rows,
-            correction,
+            correction: correction.clone(),
         }
     }
 
@@ -365,15 +363,17 @@ fn to_si(c: &Candidate, fit: &crate::screen::Ols) -> (f64, f64, &'static str) {
             let (v, e) = first(crate::weak::DELAY);
             (v, e, "s")
         }
-        "stribeck" => {
-            let (v, e) = first(crate::weak::STRIBECK);
-            (v, e, "N·m")
-        }
-        "generator_rectified" => {
-            let (v, e) = first(crate::weak::GENERATOR);
-            (v, e, "N·m·s/rad")
-        }
-        _ => (f64::NAN, f64::NAN, "-"),
+        // A torque shaped by a speed scale: its column's coefficient is the effect's size.
+        _ => match c.shaped() {
+            Some(sh) => {
+                let (v, e) = first(sh.col);
+                let unit = pendulum_model::effects::by_name(sh.effect)
+                    .and_then(|e| e.params().first())
+                    .map_or("-", |p| p.unit);
+                (v, e, unit)
+            }
+            None => (f64::NAN, f64::NAN, "-"),
+        },
     }
 }
 
@@ -447,15 +447,10 @@ fn stamp_jitter_s(ctx: &Context) -> f64 {
 /// departure that the effect does not describe.
 pub fn physically_possible(effect: &str, estimate: f64) -> bool {
     match effect {
-        "viscous_linear"
-        | "viscous_quadratic"
-        | "coulomb_bearing"
-        | "bearing_load_base_accel"
-        | "coulomb_constant"
-        | "stribeck"
-        | "generator_rectified"
-        | "extra_inertia" => estimate > 0.0,
         "encoder_offset" => estimate.abs() < std::f64::consts::PI,
+        _ if pendulum_model::effects::by_name(effect).is_some_and(|e| e.positive()) => {
+            estimate > 0.0
+        }
         _ => estimate.is_finite(),
     }
 }
@@ -856,7 +851,7 @@ fn extend(
             let sh = c.shaped().expect("checked");
             if let (Some(e), Some(p)) = (
                 pendulum_model::effects::by_name(&c.effect),
-                FitParam::find(sh.key),
+                FitParam::find(sh.shape.key),
             ) {
                 if let Some(size) = e.params().first().and_then(|q| FitParam::find(q.key)) {
                     let lo = size.bounds().0;
@@ -935,10 +930,7 @@ fn moving_runs(
 /// tells an encoder offset, and a long forced stretch a drifting speed (dropping the tails for
 /// every candidate lost a hidden offset + inertia pair and a 1e-3 Hz/s drift on drawn designs).
 fn sets_sticking_capacity(effect: &str) -> bool {
-    matches!(
-        effect,
-        "coulomb_bearing" | "bearing_load_base_accel" | "coulomb_constant" | "stribeck"
-    )
+    pendulum_model::effects::by_name(effect).is_some_and(|e| e.sets_sticking_capacity())
 }
 
 /// A measured angle's quantisation step: the smallest non-zero change between samples, rad
@@ -1246,7 +1238,7 @@ pub fn discover(
         &weak_ctx.alignments,
         base,
         &cfg.weak,
-        Correction::default(),
+        &Correction::default(),
     );
     let mut view = view0.clone();
     let zero_cols = view0.zero_cols.clone();
@@ -1336,10 +1328,10 @@ pub fn discover(
                 "encoder_offset" => corr.theta_off_rad = v,
                 _ => corr.delay_s = v,
             };
-            let mut corr = correction;
+            let mut corr = correction.clone();
             for _ in 0..3 {
                 set(&mut corr, est);
-                let v = View::build(ctx, &weak_ctx.alignments, base, &cfg.weak, corr);
+                let v = View::build(ctx, &weak_ctx.alignments, base, &cfg.weak, &corr);
                 let Some(f2) = ols(&v.id_rows, &cols) else {
                     break;
                 };
@@ -1352,7 +1344,7 @@ pub fn discover(
             }
             set(&mut corr, est);
             refined = Some((
-                View::build(ctx, &weak_ctx.alignments, base, &cfg.weak, corr),
+                View::build(ctx, &weak_ctx.alignments, base, &cfg.weak, &corr),
                 corr,
             ));
         }
@@ -1559,7 +1551,7 @@ pub fn discover(
                 if c.effect == "position_torque" {
                     format!("k = {}; ", c.k)
                 } else if let Some(sh) = c.shaped() {
-                    format!("{} = {:.4} (the screen's profile); ", sh.key, c.shape)
+                    format!("{} = {:.4} (the screen's profile); ", sh.shape.key, c.shape)
                 } else {
                     String::new()
                 },
@@ -1599,11 +1591,8 @@ pub fn discover(
             }
         }
         if accepted {
-            if let Some(k) = crate::weak::SHAPED
-                .iter()
-                .position(|sh| c.shaped().is_some_and(|s| s.col == sh.col))
-            {
-                correction.shapes[k] = c.shape;
+            if let Some(sh) = c.shaped() {
+                correction.shapes.insert(sh.col, c.shape);
             }
         }
         confirmed.push((c.effect.clone(), row.clone()));

@@ -9,7 +9,9 @@
 use pendulum_process::linalg::{inverse, solve};
 use serde::{Deserialize, Serialize};
 
-use crate::weak::{is_dynamics, set_shape, shaped, WeakRow, DELAY, INERTIA, OFFSET, SHAPED};
+use crate::weak::{
+    is_dynamics, set_shape, shaped, shaped_columns, WeakRow, DELAY, INERTIA, OFFSET,
+};
 
 /// The base models discover starts from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -53,7 +55,7 @@ pub struct Candidate {
     pub replaces: Option<usize>,
     /// position_torque harmonic.
     pub k: u32,
-    /// The shape parameter of a shaped column ([`crate::weak::SHAPED`]: stribeck's v_s, the
+    /// The shape parameter of a shaped column ([`crate::weak::shaped_columns`]: stribeck's v_s, the
     /// generator's ω_d), SI, as the screen's profile found it; NaN until profiled, 0 for
     /// unshaped candidates.
     #[serde(default)]
@@ -112,7 +114,7 @@ pub fn candidates(base: Base) -> Vec<Candidate> {
             size_band: None,
         });
     }
-    for sh in &SHAPED {
+    for sh in shaped_columns() {
         out.push(Candidate {
             shape: f64::NAN,
             ..cand(sh.effect, vec![sh.col])
@@ -387,7 +389,7 @@ pub fn profile_shape_band(
         set_shape(&mut trial, col, v);
         ols(&trial, columns)
     };
-    let grid = sh.grid;
+    let grid = sh.shape.grid;
     // Only shapes at which the effect's size is physically possible (positive: it takes energy
     // out) are candidates; a shape with the freedom to fit a negative breakaway or load found
     // "impossible" departures in campaigns with nothing hidden. With none possible the column
@@ -408,9 +410,9 @@ pub fn profile_shape_band(
         .filter(|(_, r)| r.is_finite())
         .min_by(|a, b| a.1.total_cmp(b.1))
     else {
-        let fit = at(sh.default)?;
+        let fit = at(sh.shape.default)?;
         let (v, se) = fit.coef_of(col)?;
-        return Some((sh.default, fit, (v - 1.96 * se, v + 1.96 * se)));
+        return Some((sh.shape.default, fit, (v - 1.96 * se, v + 1.96 * se)));
     };
     let (mut lo, mut hi) = (
         grid[ib.saturating_sub(1)].ln(),

@@ -454,11 +454,9 @@ pub fn describe(
 /// the measured acceleration, which the library does not).
 pub fn family_of(effect: &str) -> &'static [Variable] {
     match effect {
-        "viscous_linear"
-        | "viscous_quadratic"
-        | "coulomb_constant"
-        | "stribeck"
-        | "generator_rectified" => &[Variable::Rate],
+        "viscous_linear" | "viscous_quadratic" | "coulomb_constant" => &[Variable::Rate],
+        // A torque shaped by a speed scale follows θ̇ too.
+        _ if crate::weak::shaped_column(effect).is_some() => &[Variable::Rate],
         "position_torque" | "extra_inertia" => &[Variable::Angle, Variable::AngleInTurn],
         _ => &[],
     }

@@ -11,6 +11,7 @@
 //! Windows where the pendulum sticks (the friction force is then static and unknown), gaps, and
 //! the shaker's spin-up are left out.
 
+use pendulum_model::effects::RateShape;
 use pendulum_model::excitation::{crank_f1, crank_f2};
 use pendulum_process::{Alignment, RunData};
 use serde::{Deserialize, Serialize};
@@ -46,72 +47,50 @@ pub const OFFSET: usize = 15;
 /// Index of the accel-delay regressor in [`WeakRow::x`] (after [`TERMS`]).
 pub const DELAY: usize = TERMS.len();
 
-/// Index of the `stribeck` regressor e^{−(θ'/v_s)²} sgn θ' (N·m per N·m of T_s) in
-/// [`WeakRow::x`]: a shaped column whose speed scale v_s is not a coefficient; it holds the
-/// shape [`set_shape`] last wrote (see [`SHAPED`]).
-pub const STRIBECK: usize = DELAY + 1;
-
-/// Index of the `generator_rectified` regressor (|θ'| − ω_d)⁺ sgn θ' (its coefficient is c_g,
-/// N·m·s/rad) in [`WeakRow::x`], shaped by the dead band ω_d.
-pub const GENERATOR: usize = DELAY + 2;
-
-/// Width of [`WeakRow::x`] before the per-run zeroing contrasts.
-pub const WIDTH: usize = DELAY + 3;
-
 /// A column whose regressor depends on a parameter that is not a coefficient (a speed scale):
-/// the screen profiles it over `grid` (then refines it), one weighted fit per value.
+/// one per catalogue effect with a [`RateShape`], after the accel-delay column, in the
+/// catalogue's order. The screen profiles it over the shape's grid (then refines it), one
+/// weighted fit per value.
 #[derive(Debug, Clone, Copy)]
 pub struct Shaped {
     pub col: usize,
     pub effect: &'static str,
-    /// The shape parameter's catalogue key (`stribeck.v_s`), SI.
-    pub key: &'static str,
-    /// The shape the column holds until profiled (a mid-range value).
-    pub default: f64,
-    /// Profile grid, SI, increasing.
-    pub grid: &'static [f64],
-    /// The regressor at a speed θ' (rad/s) for a shape: the torque per unit coefficient, N·m.
-    pub f: fn(f64, f64) -> f64,
+    pub shape: &'static RateShape,
 }
 
-fn stribeck_shape(w_si: f64, v_s: f64) -> f64 {
-    (-(w_si / v_s).powi(2)).exp() * w_si.signum() * f64::from(u8::from(w_si != 0.0))
+/// The shaped columns, from the catalogue.
+pub fn shaped_columns() -> &'static [Shaped] {
+    static COLS: std::sync::OnceLock<Vec<Shaped>> = std::sync::OnceLock::new();
+    COLS.get_or_init(|| {
+        pendulum_model::effects::CATALOGUE
+            .iter()
+            .filter_map(|e| e.rate_shape().map(|s| (e.name(), s)))
+            .enumerate()
+            .map(|(i, (effect, shape))| Shaped {
+                col: DELAY + 1 + i,
+                effect,
+                shape,
+            })
+            .collect()
+    })
 }
-
-fn generator_shape(w_si: f64, omega_d: f64) -> f64 {
-    (w_si.abs() - omega_d).max(0.0) * w_si.signum()
-}
-
-/// The shaped columns. The grids span the catalogue's refit ranges: v_s geometric over
-/// 0.01–2 rad/s (the breakaway fades within a few v_s, so its size matters in ratio), ω_d linear
-/// over 0.25–16 rad/s (the band's edge is a speed the motion crosses; at ω_d → 0 the column is
-/// θ', the viscous term, so 0 itself is left out).
-pub const SHAPED: [Shaped; 2] = [
-    Shaped {
-        col: STRIBECK,
-        effect: "stribeck",
-        key: "stribeck.v_s",
-        default: 0.2,
-        grid: &[
-            0.01, 0.015, 0.022, 0.033, 0.05, 0.075, 0.11, 0.16, 0.24, 0.36, 0.54, 0.8, 1.2, 2.0,
-        ],
-        f: stribeck_shape,
-    },
-    Shaped {
-        col: GENERATOR,
-        effect: "generator_rectified",
-        key: "generator_rectified.omega_d",
-        default: 2.0,
-        grid: &[
-            0.25, 0.5, 1.0, 1.5, 2.0, 2.5, 3.0, 3.5, 4.0, 5.0, 6.0, 7.0, 8.0, 10.0, 12.0, 16.0,
-        ],
-        f: generator_shape,
-    },
-];
 
 /// The shaped column `col` describes, if any.
 pub fn shaped(col: usize) -> Option<&'static Shaped> {
-    SHAPED.iter().find(|s| s.col == col)
+    shaped_columns().iter().find(|s| s.col == col)
+}
+
+/// The shaped column of an effect, if it has one.
+pub fn shaped_column(effect: &str) -> Option<usize> {
+    shaped_columns()
+        .iter()
+        .find(|s| s.effect == effect)
+        .map(|s| s.col)
+}
+
+/// Width of [`WeakRow::x`] before the per-run zeroing contrasts.
+pub fn width() -> usize {
+    DELAY + 1 + shaped_columns().len()
 }
 
 /// Writes the shaped column `col` of every row for the shape `value` (SI), from each window's
@@ -119,7 +98,11 @@ pub fn shaped(col: usize) -> Option<&'static Shaped> {
 pub fn set_shape(rows: &mut [WeakRow], col: usize, value: f64) {
     let Some(s) = shaped(col) else { return };
     for r in rows {
-        let v: f64 = r.speeds.iter().map(|&(k, w)| k * (s.f)(w, value)).sum();
+        let v: f64 = r
+            .speeds
+            .iter()
+            .map(|&(k, w)| k * (s.shape.f)(w, value))
+            .sum();
         if r.x.len() > col {
             r.x[col] = v;
         }
@@ -131,7 +114,7 @@ pub fn set_shape(rows: &mut [WeakRow], col: usize, value: f64) {
 /// extra inertia, (1 + j)θ̈ = −G − D: the dynamics reach the target divided by 1 + j_r, the
 /// sensor terms (errors of the measured θ and A_y that the target is computed from) do not.
 pub fn is_dynamics(col: usize) -> bool {
-    col < OFFSET || col == STRIBECK || col == GENERATOR
+    col < OFFSET || shaped(col).is_some()
 }
 
 /// Per-run factors from the SI parameters of effects.md to the dimensionless coefficients of the
@@ -141,11 +124,11 @@ pub fn is_dynamics(col: usize) -> bool {
 /// share one regression: pooling dimensionless columns would ask a light and a heavy bob for
 /// the same β and c, and their difference leaked into other columns (a 2 ms "accelerometer lag"
 /// on ideal data).
-pub fn si_factors(rig: &pendulum_process::RigParams) -> [f64; WIDTH] {
+pub fn si_factors(rig: &pendulum_process::RigParams) -> Vec<f64> {
     let w0 = rig.omega0_rad_s();
     let (m, l) = (rig.m_kg, rig.l_m);
     let torque = 1.0 / (m * rig.g_m_s2 * l);
-    let mut f = [1.0; WIDTH];
+    let mut f = vec![1.0; width()];
     f[0] = 1.0 / (m * w0);
     f[1] = l / m;
     f[2] = rig.r_b_m / l;
@@ -176,7 +159,7 @@ pub struct WeakRow {
     /// Target −∫K(θ̈ + (1 + A_y) sin θ): what damping and the effects must explain.
     pub target: f64,
     /// Regressors: [`TERMS`], the accel-delay term Ȧ_y sin θ, then the shaped columns
-    /// ([`STRIBECK`], [`GENERATOR`]).
+    /// ([`shaped_columns`]).
     pub x: Vec<f64>,
     /// Regression weight (inverse residual variance of the row's regime; 1 until
     /// [`set_weights`] is called).
@@ -432,7 +415,7 @@ pub fn weak_rows(run_idx: usize, run: &RunData, al: &Alignment, cfg: &WeakConfig
                 continue;
             }
             let mut target = 0.0;
-            let mut x = vec![0.0; WIDTH];
+            let mut x = vec![0.0; width()];
             let mut speeds = Vec::with_capacity(2 * half + 1);
             let mut lib = vec![0.0; crate::sparse::LIBRARY.len()];
             let th_c = grid[c].unwrap_or(0.0);
@@ -503,7 +486,7 @@ pub fn weak_rows(run_idx: usize, run: &RunData, al: &Alignment, cfg: &WeakConfig
                 (0.0, 0.0, f64::NAN)
             };
             let ta = al.t0_s + tau_c;
-            for (xi, f) in x.iter_mut().zip(factors) {
+            for (xi, f) in x.iter_mut().zip(&factors) {
                 *xi *= f;
             }
             let ia = run
@@ -531,8 +514,8 @@ pub fn weak_rows(run_idx: usize, run: &RunData, al: &Alignment, cfg: &WeakConfig
             c += 2 * half;
         }
     }
-    for s in &SHAPED {
-        set_shape(&mut rows, s.col, s.default);
+    for s in shaped_columns() {
+        set_shape(&mut rows, s.col, s.shape.default);
     }
     rows
 }
@@ -704,15 +687,16 @@ mod shaped_tests {
             rows.extend(weak_rows(i, &run, &al, &WeakConfig::default()));
         }
         assert!(rows.len() > 60, "{} rows", rows.len());
-        let cols = [0, GENERATOR];
-        let (shape, fit) = crate::screen::profile_shape(&rows, &cols, GENERATOR).unwrap();
-        let (c, _) = fit.coef_of(GENERATOR).unwrap();
+        let gen = shaped_column("generator_rectified").unwrap();
+        let cols = [0, gen];
+        let (shape, fit) = crate::screen::profile_shape(&rows, &cols, gen).unwrap();
+        let (c, _) = fit.coef_of(gen).unwrap();
         let (bb, _) = fit.coef_of(0).unwrap();
         assert!((shape / w_d - 1.0).abs() < 0.02, "ω_d {shape} vs {w_d}");
         assert!((c / c_g - 1.0).abs() < 0.02, "c_g {c} vs {c_g}");
         assert!((bb / b - 1.0).abs() < 0.05, "b {bb} vs {b}");
         let mut wrong = rows.clone();
-        set_shape(&mut wrong, GENERATOR, 1.5);
+        set_shape(&mut wrong, gen, 1.5);
         let worse = crate::screen::ols(&wrong, &cols).unwrap();
         assert!(worse.rss > 4.0 * fit.rss, "{} vs {}", worse.rss, fit.rss);
     }
@@ -734,9 +718,10 @@ mod shaped_tests {
         d.v_break = v_s / w0;
         let (run, al) = decay(&rg, d, 2.9, 30.0);
         let rows = weak_rows(0, &run, &al, &WeakConfig::default());
-        let cols = [2, STRIBECK];
-        let (shape, fit) = crate::screen::profile_shape(&rows, &cols, STRIBECK).unwrap();
-        let (t, _) = fit.coef_of(STRIBECK).unwrap();
+        let stribeck = shaped_column("stribeck").unwrap();
+        let cols = [2, stribeck];
+        let (shape, fit) = crate::screen::profile_shape(&rows, &cols, stribeck).unwrap();
+        let (t, _) = fit.coef_of(stribeck).unwrap();
         let energy = t * shape * shape;
         assert!(
             (energy / (t_s * v_s * v_s) - 1.0).abs() < 0.10,

@@ -7,6 +7,12 @@ use crate::{Dimensionless, Physical};
 pub struct BearingLoadBaseAccel;
 
 impl Effect for BearingLoadBaseAccel {
+    fn positive(&self) -> bool {
+        true
+    }
+    fn sets_sticking_capacity(&self) -> bool {
+        true
+    }
     fn name(&self) -> &'static str {
         "bearing_load_base_accel"
     }

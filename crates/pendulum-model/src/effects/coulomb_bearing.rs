@@ -9,6 +9,12 @@ pub struct CoulombBearing;
 static PARAMS: [Param; 1] = [Param::real("mu", "mu", "1", (0.0, 0.25))];
 
 impl Effect for CoulombBearing {
+    fn positive(&self) -> bool {
+        true
+    }
+    fn sets_sticking_capacity(&self) -> bool {
+        true
+    }
     fn name(&self) -> &'static str {
         "coulomb_bearing"
     }

@@ -14,6 +14,12 @@ static PARAMS: [Param; 1] = [Param::real(
 )];
 
 impl Effect for CoulombConstant {
+    fn positive(&self) -> bool {
+        true
+    }
+    fn sets_sticking_capacity(&self) -> bool {
+        true
+    }
     fn name(&self) -> &'static str {
         "coulomb_constant"
     }

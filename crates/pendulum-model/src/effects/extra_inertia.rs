@@ -14,6 +14,9 @@ static PARAMS: [Param; 1] = [Param::real(
 )];
 
 impl Effect for ExtraInertia {
+    fn positive(&self) -> bool {
+        true
+    }
     fn name(&self) -> &'static str {
         "extra_inertia"
     }

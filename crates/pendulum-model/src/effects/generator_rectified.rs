@@ -17,7 +17,7 @@
 //! c_g ω_d (|θ'| − ω_d)⁺: the split needs c_g and ω_d only (R and k_e set the current and
 //! voltage, not the powers).
 
-use super::{Alternative, Decompiled, Draw, Effect, Kind, Param, Survey};
+use super::{Alternative, Decompiled, Draw, Effect, Kind, Param, RateShape, Survey};
 use crate::{Dimensionless, Physical};
 
 #[derive(Debug)]
@@ -82,7 +82,25 @@ static ALTERNATIVE: Alternative = Alternative {
     convert: from_electrical,
 };
 
+/// Discover's column: (|θ'| − ω_d)⁺ sgn θ', profiled over ω_d linearly across 0.25–16 rad/s
+/// (the band's edge is a speed the motion crosses; at ω_d → 0 the column is θ', the viscous
+/// term, so 0 itself is left out).
+static SHAPE: RateShape = RateShape {
+    key: "generator_rectified.omega_d",
+    default: 2.0,
+    grid: &[
+        0.25, 0.5, 1.0, 1.5, 2.0, 2.5, 3.0, 3.5, 4.0, 5.0, 6.0, 7.0, 8.0, 10.0, 12.0, 16.0,
+    ],
+    f: |w, omega_d| (w.abs() - omega_d).max(0.0) * w.signum(),
+};
+
 impl Effect for GeneratorRectified {
+    fn rate_shape(&self) -> Option<&'static RateShape> {
+        Some(&SHAPE)
+    }
+    fn positive(&self) -> bool {
+        true
+    }
     fn name(&self) -> &'static str {
         "generator_rectified"
     }

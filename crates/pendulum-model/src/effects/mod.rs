@@ -146,6 +146,22 @@ pub struct Alternative {
     pub convert: fn(&[f64]) -> Result<Vec<f64>, String>,
 }
 
+/// How discover's equation-error screen writes a torque that follows θ' through a speed scale
+/// that is no coefficient (stribeck's v_s, the generator's ω_d): T = size · f(θ', shape). The
+/// screen profiles the shape over `grid` (each value one weighted fit), so the effect needs no
+/// column of its own in discover.
+#[derive(Debug, Clone, Copy)]
+pub struct RateShape {
+    /// The shape parameter's key (one of the effect's [`Param`]s), SI.
+    pub key: &'static str,
+    /// The shape a column holds until profiled (mid-range).
+    pub default: f64,
+    /// The profile grid, SI, increasing, spanning the parameter's refit range.
+    pub grid: &'static [f64],
+    /// The torque per unit of the effect's first parameter at speed θ' (rad/s), N·m.
+    pub f: fn(f64, f64) -> f64,
+}
+
 /// What [`Effect::decompile`] finds in the coefficients.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Decompiled {
@@ -206,6 +222,24 @@ pub trait Effect: Sync + std::fmt::Debug {
     /// Adds the effect to the sensor and forcing transform (input and observation effects).
     fn sense(&self, values: &[f64], s: &mut Sensors) {
         let _ = (values, s);
+    }
+
+    /// Whether its size (first parameter) is physically positive: a loss that takes energy out
+    /// (a negative one would feed energy in) or an inertia. Discover never accepts such an
+    /// effect with a size ≤ 0.
+    fn positive(&self) -> bool {
+        false
+    }
+
+    /// Whether it adds to the dry friction's sticking capacity (what holds the pendulum at
+    /// rest), which discover's trajectory refit judges without the runs' still tails.
+    fn sets_sticking_capacity(&self) -> bool {
+        false
+    }
+
+    /// A torque following θ' through a speed scale (see [`RateShape`]).
+    fn rate_shape(&self) -> Option<&'static RateShape> {
+        None
     }
 }
 

@@ -2,7 +2,7 @@
 //! the excess T_s fades within a few v_s: T_s e^{−(θ'/v_s)²} sgn θ' in T_fric, and T_s in the
 //! sticking capacity (`effects.md`).
 
-use super::{Decompiled, Draw, Effect, Kind, Param, Survey};
+use super::{Decompiled, Draw, Effect, Kind, Param, RateShape, Survey};
 use crate::{Dimensionless, Physical};
 
 #[derive(Debug)]
@@ -23,7 +23,33 @@ static PARAMS: [Param; 2] = [
     },
 ];
 
+/// Discover's column: e^{−(θ'/v_s)²} sgn θ' (0 at rest), profiled over v_s geometrically across
+/// the refit range (the breakaway fades within a few v_s, so its scale matters in ratio).
+static SHAPE: RateShape = RateShape {
+    key: "stribeck.v_s",
+    default: 0.2,
+    grid: &[
+        0.01, 0.015, 0.022, 0.033, 0.05, 0.075, 0.11, 0.16, 0.24, 0.36, 0.54, 0.8, 1.2, 2.0,
+    ],
+    f: |w, v_s| {
+        if w == 0.0 {
+            0.0
+        } else {
+            (-(w / v_s).powi(2)).exp() * w.signum()
+        }
+    },
+};
+
 impl Effect for Stribeck {
+    fn rate_shape(&self) -> Option<&'static RateShape> {
+        Some(&SHAPE)
+    }
+    fn positive(&self) -> bool {
+        true
+    }
+    fn sets_sticking_capacity(&self) -> bool {
+        true
+    }
     fn name(&self) -> &'static str {
         "stribeck"
     }

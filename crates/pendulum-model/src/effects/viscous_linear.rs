@@ -9,6 +9,9 @@ pub struct ViscousLinear;
 static PARAMS: [Param; 1] = [Param::real("b", "b_n_s_m", "N·s/m", (0.0, 1.0))];
 
 impl Effect for ViscousLinear {
+    fn positive(&self) -> bool {
+        true
+    }
     fn name(&self) -> &'static str {
         "viscous_linear"
     }

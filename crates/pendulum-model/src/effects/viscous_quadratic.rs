@@ -9,6 +9,9 @@ pub struct ViscousQuadratic;
 static PARAMS: [Param; 1] = [Param::real("a", "a_kg_m", "kg/m", (0.0, 1.0))];
 
 impl Effect for ViscousQuadratic {
+    fn positive(&self) -> bool {
+        true
+    }
     fn name(&self) -> &'static str {
         "viscous_quadratic"
     }
