@@ -280,6 +280,10 @@ impl Stage for FitStage {
         let runs = ctx.prepared(Role::Identify, &self.0.window, self.name())?;
         ctx.fit_window = Some(self.0.window);
         let out = identify(&runs, &self.0, ctx.progress.clone())?;
+        // Free decays: the fit and the envelope reach one verdict (issue 16 item 1).
+        let (out, law) =
+            crate::identify::decay_law(&runs, &ctx.runs, &ctx.alignments, &self.0, out);
+        ctx.notes.extend(law);
         ctx.notes
             .extend(crate::identify::shared_omega0_notes(&runs, &out));
         ctx.notes
