@@ -1000,9 +1000,10 @@ impl pendulum_fit::Problem for Constrained<'_, '_> {
 /// against each run's envelope over the same window, and refitted (Nelder–Mead from the fit,
 /// within the changed boxes) where the two views contradict each other:
 ///
-/// - a part of the law that the envelope resolves (its interval clear of 0) is not set below
-///   the envelope's lower bound: a fit that calls a decay pure dry friction while the envelope
-///   measures a viscous part is the trajectory fit's noise speaking, not the data;
+/// - a part of the law that the envelope resolves (its interval clear of 0) is not left below
+///   the envelope's lower bound (widened by [`pendulum_explain::LOSS_BAND_FACTOR`]: the
+///   envelope's loss curves are first-order); a fit that calls a decay pure dry friction while
+///   the envelope measures a viscous part is refitted with the part at least that bound;
 /// - a term whose implied loss per cycle contradicts the measured one (beyond the measured
 ///   interval widened by [`pendulum_explain::LOSS_BAND_FACTOR`]) while the model without it
 ///   does not is never kept: it is fixed at 0.
@@ -1058,7 +1059,7 @@ pub fn decay_law(
             continue;
         };
         let Some(k) = index(p) else { continue };
-        if low.is_finite() && v < low && low < bounds[k].1 {
+        if low.is_finite() && v < low / pendulum_explain::LOSS_BAND_FACTOR && low < bounds[k].1 {
             actions.push(format!(
                 "{} {} = {v:.3e} was below the envelope's interval (lower bound {low:.3e}): \
                  refitted with {} ≥ {low:.3e}",
@@ -1195,7 +1196,7 @@ pub fn decay_law(
             .filter_map(|part| {
                 let low = re.resolved_low(*part)?;
                 match part.value(&spec, &out.params) {
-                    Some(v) if v >= low * (1.0 - 1e-9) => None,
+                    Some(v) if v >= low / pendulum_explain::LOSS_BAND_FACTOR => None,
                     Some(v) => Some(format!("{} {v:.3e} below {low:.3e}", part.name())),
                     None => Some(format!(
                         "{} resolved (≥ {low:.3e}) but not in the model",
