@@ -8,6 +8,7 @@ mod independent;
 mod ingest;
 mod maps;
 mod real;
+mod real_decays;
 mod shard;
 mod unexplained;
 mod util;

@@ -748,6 +748,23 @@ fn resolved_turning_points(
         res.ended_swing_rad = Some(swing(&tps[n..n + 2]));
         res.dropped_turning_points = tps.len() - (n + 1);
         tps.truncate(n + 1);
+    } else if let Some(last) = tps.last().filter(|_| q > 0.0) {
+        // The swing after the last turning point found: too small for the hysteresis to close
+        // it into a turning point. When it is under MIN_SWING_STEPS steps (but a step at least:
+        // not a count flickering at rest), the resolution ended the analysis there, not the
+        // pendulum's stop (the MultiArm small decay read at 4096 counts: its 14th swing, 2.6
+        // counts, went unreported as "every swing found is above it").
+        let after = &th[(last.sample + 1).min(th.len())..];
+        let far = if last.sign > 0 {
+            after.iter().copied().fold(f64::INFINITY, f64::min)
+        } else {
+            after.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+        };
+        let next = 0.5 * (last.theta_rad - far).abs();
+        if next.is_finite() && next >= q && next < res.min_swing_rad {
+            res.ended_at_s = Some(last.t_s);
+            res.ended_swing_rad = Some(next);
+        }
     }
     (tps, noise, res)
 }
