@@ -10,5 +10,6 @@ mod maps;
 mod real;
 mod real_decays;
 mod shard;
+mod twin_decays;
 mod unexplained;
 mod util;

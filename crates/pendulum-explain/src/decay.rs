@@ -1208,8 +1208,18 @@ fn bic(rss: f64, n: usize, k: usize) -> f64 {
 /// The envelope of a free decay: turning points, loss per cycle against amplitude, and its
 /// shape.
 pub fn envelope(t_s: &[f64], theta_rad: &[f64]) -> Result<EnvelopeFit, DecayError> {
+    envelope_with(t_s, theta_rad, None)
+}
+
+/// [`envelope`] with the angle's resolution, rad, when the capture states it (`counts_per_rev`):
+/// `None` takes the smallest step seen in the data.
+pub fn envelope_with(
+    t_s: &[f64],
+    theta_rad: &[f64],
+    resolution_rad: Option<f64>,
+) -> Result<EnvelopeFit, DecayError> {
     check_input(t_s, theta_rad)?;
-    let (tps, noise, res) = resolved_turning_points(t_s, theta_rad, None);
+    let (tps, noise, res) = resolved_turning_points(t_s, theta_rad, resolution_rad);
     envelope_of(&tps, noise, res, 1.96)
 }
 

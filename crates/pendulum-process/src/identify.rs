@@ -873,9 +873,11 @@ struct RunEnvelope {
 
 impl RunEnvelope {
     /// The envelope resolves `part` (a catalogue coefficient of it with its interval clear of
-    /// 0): the interval's lower bound (the largest, when it kept both dry terms).
-    fn resolved_low(&self, part: LawPart) -> Option<f64> {
-        self.env
+    /// 0): the part's interval (the sum over both dry terms when it kept both), widened by
+    /// [`ENVELOPE_TOLERANCE`] of its estimate on either side.
+    fn resolved(&self, part: LawPart) -> Option<(f64, f64)> {
+        let coefs: Vec<&pendulum_explain::Coef> = self
+            .env
             .catalogue
             .iter()
             .filter(|c| {
@@ -883,15 +885,31 @@ impl RunEnvelope {
                     .iter()
                     .any(|(_, t)| t.name() == c.name && LawPart::of(*t) == Some(part))
             })
-            .filter(|c| c.significant && c.ci_low > 0.0)
-            .map(|c| c.ci_low)
-            .reduce(f64::max)
+            .collect();
+        if !coefs.iter().any(|c| c.significant && c.ci_low > 0.0) {
+            return None;
+        }
+        let est: f64 = coefs.iter().map(|c| c.estimate).sum();
+        let lo: f64 = coefs.iter().map(|c| c.ci_low.max(0.0)).sum();
+        let hi: f64 = coefs.iter().map(|c| c.ci_high).sum();
+        let tol = ENVELOPE_TOLERANCE * est.abs();
+        Some(((lo - tol).max(0.0), hi + tol))
     }
 }
 
+/// How far beyond the envelope's interval, as a fraction of its estimate, a trajectory fit's
+/// value still agrees with it: the fit has no interval of its own, and the envelope's loss
+/// curves and refined turning points are not exact (a noise-free twin's fit and envelope differ
+/// by about 1 %, their intervals by less).
+const ENVELOPE_TOLERANCE: f64 = 0.1;
+
 /// The envelope of a prepared free decay over the fit's window (the data the fit saw), with its
 /// measured loss per cycle in amplitude bands. `None` when the window holds too few swings.
-fn run_envelope(run: &PreparedRun, raw: Option<(&RunData, &Alignment)>) -> Option<RunEnvelope> {
+fn run_envelope(
+    run: &PreparedRun,
+    raw: Option<(&RunData, &Alignment)>,
+    resolution_rad: Option<f64>,
+) -> Option<RunEnvelope> {
     if !run.free || !(run.omega0_rad_s > 0.0) {
         return None;
     }
@@ -910,7 +928,7 @@ fn run_envelope(run: &PreparedRun, raw: Option<(&RunData, &Alignment)>) -> Optio
             run.theta.clone(),
         ),
     };
-    let env = pendulum_explain::envelope(&t_s, &theta).ok()?;
+    let env = pendulum_explain::envelope_with(&t_s, &theta, resolution_rad).ok()?;
     let mut rows: Vec<(f64, f64)> = env
         .rows
         .iter()
@@ -1000,10 +1018,10 @@ impl pendulum_fit::Problem for Constrained<'_, '_> {
 /// against each run's envelope over the same window, and refitted (Nelder–Mead from the fit,
 /// within the changed boxes) where the two views contradict each other:
 ///
-/// - a part of the law that the envelope resolves (its interval clear of 0) is not left below
-///   the envelope's lower bound (widened by [`pendulum_explain::LOSS_BAND_FACTOR`]: the
-///   envelope's loss curves are first-order); a fit that calls a decay pure dry friction while
-///   the envelope measures a viscous part is refitted with the part at least that bound;
+/// - a part of the law that the envelope resolves (its interval clear of 0) is not left outside
+///   the envelope's interval (widened by [`ENVELOPE_TOLERANCE`] of its estimate): a fit that
+///   calls a decay pure dry friction while the envelope measures a viscous part is refitted
+///   with the part inside it;
 /// - a term whose implied loss per cycle contradicts the measured one (beyond the measured
 ///   interval widened by [`pendulum_explain::LOSS_BAND_FACTOR`]) while the model without it
 ///   does not is never kept: it is fixed at 0.
@@ -1012,8 +1030,7 @@ impl pendulum_fit::Problem for Constrained<'_, '_> {
 /// Shaker runs pass through unchanged, with no notes.
 pub fn decay_law(
     runs: &[PreparedRun],
-    raw: &[RunData],
-    alignments: &std::collections::BTreeMap<String, Alignment>,
+    ctx: &crate::pipeline::Context,
     cfg: &FitConfig,
     mut out: FitOutcome,
 ) -> (FitOutcome, Vec<String>) {
@@ -1024,8 +1041,12 @@ pub fn decay_law(
     let envs: Vec<Option<RunEnvelope>> = runs
         .iter()
         .map(|r| {
-            let rd = raw.iter().find(|d| d.id == r.id);
-            run_envelope(r, rd.zip(alignments.get(&r.id)))
+            let rd = ctx.runs.iter().find(|d| d.id == r.id);
+            run_envelope(
+                r,
+                rd.zip(ctx.alignments.get(&r.id)),
+                ctx.resolutions.get(&r.id).copied(),
+            )
         })
         .collect();
     let spec = out.spec.clone();
@@ -1047,35 +1068,49 @@ pub fn decay_law(
     }
     let index = |p: FitParam| spec.params.iter().position(|q| *q == p);
     let mut actions = Vec::new();
-    // Resolved by the envelope, dropped by the fit: the part's box is raised to the envelope's
-    // bound (the smallest among the runs that resolve it: no run's interval is exceeded).
+    // A part the envelope resolves, outside its interval in the fit (a decay called pure dry
+    // friction while the envelope measures a viscous part; viscous traded for a quadratic drag
+    // the envelope does not see): the part's box becomes the envelope's interval (common to
+    // every run that resolves it; none when they have nothing in common: the verdicts say so).
     for part in LawPart::ALL {
-        let low = envs
+        let (lo, hi) = envs
             .iter()
             .flatten()
-            .filter_map(|e| e.resolved_low(part))
-            .fold(f64::INFINITY, f64::min);
+            .filter_map(|e| e.resolved(part))
+            .fold((f64::NEG_INFINITY, f64::INFINITY), |a, b| {
+                (a.0.max(b.0), a.1.min(b.1))
+            });
         let (Some(v), Some(&p)) = (part.value(&spec, &x[..n]), part.params(&spec).first()) else {
             continue;
         };
         let Some(k) = index(p) else { continue };
-        if low.is_finite() && v < low / pendulum_explain::LOSS_BAND_FACTOR && low < bounds[k].1 {
-            actions.push(format!(
-                "{} {} = {v:.3e} was below the envelope's interval (lower bound {low:.3e}): \
-                 refitted with {} ≥ {low:.3e}",
-                part.name(),
-                p.name(),
-                p.name()
-            ));
-            bounds[k].0 = low;
-            x[k] = x[k].max(low);
+        if !(lo.is_finite() && hi.is_finite() && lo <= hi) || (lo..=hi).contains(&v) {
+            continue;
         }
+        // The other parameters of the part (c beside M) stay as fitted.
+        let others = v - x[k];
+        let (b_lo, b_hi) = (
+            (lo - others).max(bounds[k].0),
+            (hi - others).min(bounds[k].1),
+        );
+        if !(b_lo < b_hi) {
+            continue;
+        }
+        actions.push(format!(
+            "{} {} = {v:.3e} was outside the envelope's interval [{lo:.3e}, {hi:.3e}]: refitted \
+             with {} in [{b_lo:.3e}, {b_hi:.3e}]",
+            part.name(),
+            p.name(),
+            p.name()
+        ));
+        bounds[k] = (b_lo, b_hi);
+        x[k] = x[k].clamp(b_lo, b_hi);
     }
     // A term whose loss per cycle contradicts the measured one, where the model without it does
     // not, is vetoed.
     for &(p, t) in &DECAY_TERMS {
         let Some(k) = index(p) else { continue };
-        if !(x[k] > 0.0) || bounds[k].0 > 0.0 {
+        if !(x[k] > 0.0) || bounds[k].0 > 0.0 || bounds[k].1 < objective.bounds_vec()[k].1 {
             continue;
         }
         let vetoed = envs.iter().flatten().any(|e| {
@@ -1189,17 +1224,21 @@ pub fn decay_law(
                 )
             })
             .collect();
-        // One verdict: the views agree when every part the envelope resolves is at least its
-        // lower bound in the fit and no band's measured loss is contradicted.
+        // One verdict: the views agree when every part the envelope resolves is within its
+        // interval (widened by ENVELOPE_TOLERANCE) in the fit and no band's measured loss is
+        // contradicted.
         let below: Vec<String> = LawPart::ALL
             .iter()
             .filter_map(|part| {
-                let low = re.resolved_low(*part)?;
+                let (lo, hi) = re.resolved(*part)?;
                 match part.value(&spec, &out.params) {
-                    Some(v) if v >= low / pendulum_explain::LOSS_BAND_FACTOR => None,
-                    Some(v) => Some(format!("{} {v:.3e} below {low:.3e}", part.name())),
+                    Some(v) if (lo..=hi).contains(&v) => None,
+                    Some(v) => Some(format!(
+                        "{} {v:.3e} outside the envelope's [{lo:.3e}, {hi:.3e}]",
+                        part.name()
+                    )),
                     None => Some(format!(
-                        "{} resolved (≥ {low:.3e}) but not in the model",
+                        "{} resolved ([{lo:.3e}, {hi:.3e}]) but not in the model",
                         part.name()
                     )),
                 }

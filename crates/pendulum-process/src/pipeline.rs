@@ -51,6 +51,9 @@ pub struct Context {
     /// show the residual the fit minimised).
     pub fit_window: Option<crate::identify::Window>,
     pub validate_window: Option<crate::identify::Window>,
+    /// Each run's angle resolution, rad, where its capture states it (`counts_per_rev`): it
+    /// bounds the free-decay envelope the fit is checked against.
+    pub resolutions: BTreeMap<String, f64>,
 }
 
 impl Context {
@@ -281,8 +284,7 @@ impl Stage for FitStage {
         ctx.fit_window = Some(self.0.window);
         let out = identify(&runs, &self.0, ctx.progress.clone())?;
         // Free decays: the fit and the envelope reach one verdict (issue 16 item 1).
-        let (out, law) =
-            crate::identify::decay_law(&runs, &ctx.runs, &ctx.alignments, &self.0, out);
+        let (out, law) = crate::identify::decay_law(&runs, ctx, &self.0, out);
         ctx.notes.extend(law);
         ctx.notes
             .extend(crate::identify::shared_omega0_notes(&runs, &out));
