@@ -239,7 +239,54 @@ fn regression_issue_16_shared_omega0_is_warned() {
         "{notes:?}"
     );
     assert!(crate::identify::shared_omega0_notes(std::slice::from_ref(&pa), &fit).is_empty());
-    assert!(crate::identify::shared_omega0_notes(&[pa, pa2], &fit).is_empty());
+    assert!(crate::identify::shared_omega0_notes(&[pa.clone(), pa2.clone()], &fit).is_empty());
+
+    // Issue 16 item 4: runs that differ also get their own ω0 and hanging angle, each its
+    // swings' (the stretched clock's 7.0/1.3 rad/s), with the same damping per unit inertia
+    // (β scales with the time unit: 1/1.3 of it on the slow clock is the same per swing).
+    let (pb, ..) = prepare(&b);
+    let cfg = FitConfig {
+        model: "linear".into(),
+        effects: vec![FitParam::Mu],
+        window,
+        np: Some(30),
+        max_generations: 60,
+        threads: Some(1),
+        ..FitConfig::default()
+    };
+    let runs = [pa.clone(), pb];
+    let shared = identify(&runs, &cfg, None).expect("shared fit");
+    let alone = crate::identify::per_run_fits(&runs, &cfg, &shared).expect("per-run fits");
+    assert_eq!(alone.len(), 2);
+    for (fit, w_want) in alone.iter().zip([OMEGA0, OMEGA0 / 1.3]) {
+        let w = fit.spec.value_of(FitParam::Omega0, &fit.params).unwrap();
+        let off = fit
+            .spec
+            .value_of(FitParam::of("encoder_offset"), &fit.params)
+            .unwrap();
+        let b = fit.spec.value_of(FitParam::Beta, &fit.params).unwrap();
+        eprintln!("omega0 {w} offset {off} beta {b}");
+        assert!(
+            (w - w_want).abs() < 0.005 * w_want,
+            "omega0 {w} vs {w_want}"
+        );
+        assert!((off - OFFSET).abs() < 5e-4, "offset {off}");
+        assert!((b - BETA).abs() < 0.05 * BETA, "beta {b}");
+    }
+    let notes = crate::identify::per_run_notes(&runs, &shared, &alone);
+    eprintln!("{notes:?}");
+    assert!(
+        notes
+            .iter()
+            .any(|n| n.contains("slow alone") && n.contains("omega0_rad_s = 5.38")),
+        "{notes:?}"
+    );
+    // Runs of one pendulum are fitted together only.
+    let one = [pa, pa2];
+    let shared = identify(&one, &cfg, None).expect("shared fit");
+    assert!(crate::identify::per_run_fits(&one, &cfg, &shared)
+        .unwrap()
+        .is_empty());
 }
 
 /// Issue 16 item 4: a free decay that comes to rest inside the classified tail is `rest`, not

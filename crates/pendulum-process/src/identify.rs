@@ -1290,3 +1290,58 @@ fn notes_refused(actions: &mut Vec<String>, before: usize, after: usize, e0: f64
          law (fit them separately)"
     ));
 }
+
+/// Per-run ω0 and hanging angle (issue 16 item 4): free decays whose own ω0 differ (see
+/// [`shared_omega0_notes`]) are also fitted one by one, each with its own ω0, its own swing
+/// centre (`encoder_offset`: the hanging angle) and its own damping, so that the report gives
+/// every run the values its swings say beside the forced shared fit. Empty when the runs agree
+/// (or are one run, or not free decays).
+pub fn per_run_fits(
+    runs: &[PreparedRun],
+    cfg: &FitConfig,
+    shared: &FitOutcome,
+) -> Result<Vec<FitOutcome>, ProcessError> {
+    if shared_omega0_notes(runs, shared).is_empty() {
+        return Ok(Vec::new());
+    }
+    runs.iter()
+        .map(|r| identify(std::slice::from_ref(r), cfg, None))
+        .collect()
+}
+
+/// One note per run of [`per_run_fits`]: its own ω0, hanging angle and damping, E_θ against the
+/// shared fit's on that run, and its parameters at a bound.
+pub fn per_run_notes(
+    runs: &[PreparedRun],
+    shared: &FitOutcome,
+    fits: &[FitOutcome],
+) -> Vec<String> {
+    let mut notes = Vec::new();
+    for (run, fit) in runs.iter().zip(fits) {
+        let values: Vec<String> = fit
+            .spec
+            .params
+            .iter()
+            .zip(&fit.params)
+            .map(|(p, v)| format!("{} = {v:.4e}", p.name()))
+            .collect();
+        let shared_e = shared
+            .runs
+            .iter()
+            .find(|r| r.id == run.id)
+            .map_or(f64::NAN, |r| r.e_theta);
+        notes.push(format!(
+            "fit {} per run, {} alone (its own omega0 and hanging angle): {}; E_θ {:.4} (shared fit: {shared_e:.4})",
+            fit.spec.name,
+            run.id,
+            values.join(", "),
+            fit.e_theta
+        ));
+        notes.extend(
+            params_at_bounds(std::slice::from_ref(run), fit)
+                .into_iter()
+                .map(|n| format!("{} alone: {n}", run.id)),
+        );
+    }
+    notes
+}
