@@ -256,9 +256,13 @@ fn regression_issue_16_shared_omega0_is_warned() {
     };
     let runs = [pa.clone(), pb];
     let shared = identify(&runs, &cfg, None).expect("shared fit");
-    let alone = crate::identify::per_run_fits(&runs, &cfg, &shared).expect("per-run fits");
+    let mut ctx = crate::pipeline::Context::new(vec![a.clone(), b.clone()]);
+    for r in [&a, &b] {
+        ctx.alignments.insert(r.id.clone(), prepare(r).1);
+    }
+    let alone = crate::identify::per_run_fits(&runs, &ctx, &cfg, &shared).expect("per-run fits");
     assert_eq!(alone.len(), 2);
-    for (fit, w_want) in alone.iter().zip([OMEGA0, OMEGA0 / 1.3]) {
+    for ((fit, _), w_want) in alone.iter().zip([OMEGA0, OMEGA0 / 1.3]) {
         let w = fit.spec.value_of(FitParam::Omega0, &fit.params).unwrap();
         let off = fit
             .spec
@@ -284,7 +288,7 @@ fn regression_issue_16_shared_omega0_is_warned() {
     // Runs of one pendulum are fitted together only.
     let one = [pa, pa2];
     let shared = identify(&one, &cfg, None).expect("shared fit");
-    assert!(crate::identify::per_run_fits(&one, &cfg, &shared)
+    assert!(crate::identify::per_run_fits(&one, &ctx, &cfg, &shared)
         .unwrap()
         .is_empty());
 }

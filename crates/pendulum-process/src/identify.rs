@@ -1294,18 +1294,30 @@ fn notes_refused(actions: &mut Vec<String>, before: usize, after: usize, e0: f64
 /// Per-run ω0 and hanging angle (issue 16 item 4): free decays whose own ω0 differ (see
 /// [`shared_omega0_notes`]) are also fitted one by one, each with its own ω0, its own swing
 /// centre (`encoder_offset`: the hanging angle) and its own damping, so that the report gives
-/// every run the values its swings say beside the forced shared fit. Empty when the runs agree
-/// (or are one run, or not free decays).
+/// every run the values its swings say beside the forced shared fit. Each fit goes through the
+/// run's [`decay_law`] (with `ctx`), whose refit notes, if any, come with it. Empty when the runs
+/// agree (or are one run, or not free decays).
 pub fn per_run_fits(
     runs: &[PreparedRun],
+    ctx: &crate::pipeline::Context,
     cfg: &FitConfig,
     shared: &FitOutcome,
-) -> Result<Vec<FitOutcome>, ProcessError> {
+) -> Result<Vec<(FitOutcome, Vec<String>)>, ProcessError> {
     if shared_omega0_notes(runs, shared).is_empty() {
         return Ok(Vec::new());
     }
     runs.iter()
-        .map(|r| identify(std::slice::from_ref(r), cfg, None))
+        .map(|r| {
+            let one = std::slice::from_ref(r);
+            let (fit, notes) = decay_law(one, ctx, cfg, identify(one, cfg, None)?);
+            // The run's verdict is stated once, for the shared fit; the refit's note stays.
+            let refit = notes
+                .into_iter()
+                .filter(|n| n.starts_with("decay law, fit"))
+                .map(|n| format!("{} alone: {n}", r.id))
+                .collect();
+            Ok((fit, refit))
+        })
         .collect()
 }
 
@@ -1314,10 +1326,10 @@ pub fn per_run_fits(
 pub fn per_run_notes(
     runs: &[PreparedRun],
     shared: &FitOutcome,
-    fits: &[FitOutcome],
+    fits: &[(FitOutcome, Vec<String>)],
 ) -> Vec<String> {
     let mut notes = Vec::new();
-    for (run, fit) in runs.iter().zip(fits) {
+    for (run, (fit, refit)) in runs.iter().zip(fits) {
         let values: Vec<String> = fit
             .spec
             .params
@@ -1337,6 +1349,7 @@ pub fn per_run_notes(
             values.join(", "),
             fit.e_theta
         ));
+        notes.extend(refit.iter().cloned());
         notes.extend(
             params_at_bounds(std::slice::from_ref(run), fit)
                 .into_iter()

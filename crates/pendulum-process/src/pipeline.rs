@@ -289,7 +289,7 @@ impl Stage for FitStage {
         ctx.notes
             .extend(crate::identify::shared_omega0_notes(&runs, &out));
         // Free decays that do not share ω0 also get their own fits, reported per run.
-        let alone = crate::identify::per_run_fits(&runs, &self.0, &out)?;
+        let alone = crate::identify::per_run_fits(&runs, ctx, &self.0, &out)?;
         ctx.notes
             .extend(crate::identify::per_run_notes(&runs, &out, &alone));
         ctx.notes
