@@ -3595,4 +3595,53 @@ mod tests {
             assert!(!text.contains("noise 1.0e-12"), "{text}");
         }
     }
+
+    /// Issue 16 item 2: a dry-friction decay on a 4096-count encoder whose last half swing,
+    /// 2.25 counts, never closes into a turning point (the hysteresis needs 3 counts back): the
+    /// swings between the turning points found are all above 3 counts, yet the resolution ended
+    /// the analysis, and the report says where (it said "every swing found is above it").
+    #[test]
+    fn regression_issue_16_resolution_ends_at_an_unclosed_last_swing() {
+        let q = std::f64::consts::TAU / 4096.0;
+        // Turning points of a decay losing 1.5 counts per half swing: 12, 10.5, …, 3, 1.5.
+        let amps: Vec<f64> = (0..8).map(|k| (12.0 - 1.5 * k as f64) * q).collect();
+        let fs = 1000.0;
+        let (mut t, mut th) = (Vec::new(), Vec::new());
+        let push = |t: &mut Vec<f64>, th: &mut Vec<f64>, v: f64| {
+            t.push(t.len() as f64 / fs);
+            th.push((v / q).floor() * q);
+        };
+        for _ in 0..300 {
+            push(&mut t, &mut th, amps[0]);
+        }
+        for k in 0..amps.len() - 1 {
+            let (a, b) = (
+                amps[k] * if k % 2 == 0 { 1.0 } else { -1.0 },
+                amps[k + 1] * if k % 2 == 0 { -1.0 } else { 1.0 },
+            );
+            for i in 0..500 {
+                let s = i as f64 / 500.0;
+                let v = 0.5 * (a + b) + 0.5 * (a - b) * (std::f64::consts::PI * s).cos();
+                push(&mut t, &mut th, v);
+            }
+        }
+        let rest = *amps.last().unwrap() * -1.0;
+        for _ in 0..3000 {
+            push(&mut t, &mut th, rest);
+        }
+        let env = envelope_with(&t, &th, Some(q)).expect("envelope");
+        let r = &env.resolution;
+        eprintln!("{}", r.describe());
+        let ended = r.ended_at_s.expect("the resolution ended the analysis");
+        // At the last turning point found, +3 counts at 3.3 s: the swing after it is 2.25.
+        assert!((ended - 3.3).abs() < 0.05, "ended at {ended} s");
+        let next = r.ended_swing_rad.expect("the swing that ended it") / q;
+        assert!((next - 2.25).abs() < 0.6, "{next} counts");
+        assert!(
+            r.describe()
+                .contains("the resolution ended the analysis at t ="),
+            "{}",
+            r.describe()
+        );
+    }
 }
