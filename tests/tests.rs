@@ -8,6 +8,8 @@ mod independent;
 mod ingest;
 mod maps;
 mod real;
+mod real_decays;
 mod shard;
+mod twin_decays;
 mod unexplained;
 mod util;

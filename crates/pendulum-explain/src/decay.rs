@@ -748,6 +748,23 @@ fn resolved_turning_points(
         res.ended_swing_rad = Some(swing(&tps[n..n + 2]));
         res.dropped_turning_points = tps.len() - (n + 1);
         tps.truncate(n + 1);
+    } else if let Some(last) = tps.last().filter(|_| q > 0.0) {
+        // The swing after the last turning point found: too small for the hysteresis to close
+        // it into a turning point. When it is under MIN_SWING_STEPS steps (but a step at least:
+        // not a count flickering at rest), the resolution ended the analysis there, not the
+        // pendulum's stop (the MultiArm small decay read at 4096 counts: its 14th swing, 2.6
+        // counts, went unreported as "every swing found is above it").
+        let after = &th[(last.sample + 1).min(th.len())..];
+        let far = if last.sign > 0 {
+            after.iter().copied().fold(f64::INFINITY, f64::min)
+        } else {
+            after.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+        };
+        let next = 0.5 * (last.theta_rad - far).abs();
+        if next.is_finite() && next >= q && next < res.min_swing_rad {
+            res.ended_at_s = Some(last.t_s);
+            res.ended_swing_rad = Some(next);
+        }
     }
     (tps, noise, res)
 }
@@ -1191,8 +1208,18 @@ fn bic(rss: f64, n: usize, k: usize) -> f64 {
 /// The envelope of a free decay: turning points, loss per cycle against amplitude, and its
 /// shape.
 pub fn envelope(t_s: &[f64], theta_rad: &[f64]) -> Result<EnvelopeFit, DecayError> {
+    envelope_with(t_s, theta_rad, None)
+}
+
+/// [`envelope`] with the angle's resolution, rad, when the capture states it (`counts_per_rev`):
+/// `None` takes the smallest step seen in the data.
+pub fn envelope_with(
+    t_s: &[f64],
+    theta_rad: &[f64],
+    resolution_rad: Option<f64>,
+) -> Result<EnvelopeFit, DecayError> {
     check_input(t_s, theta_rad)?;
-    let (tps, noise, res) = resolved_turning_points(t_s, theta_rad, None);
+    let (tps, noise, res) = resolved_turning_points(t_s, theta_rad, resolution_rad);
     envelope_of(&tps, noise, res, 1.96)
 }
 
@@ -3567,5 +3594,54 @@ mod tests {
             assert!(text.contains("the resolution ended the analysis"), "{text}");
             assert!(!text.contains("noise 1.0e-12"), "{text}");
         }
+    }
+
+    /// Issue 16 item 2: a dry-friction decay on a 4096-count encoder whose last half swing,
+    /// 2.25 counts, never closes into a turning point (the hysteresis needs 3 counts back): the
+    /// swings between the turning points found are all above 3 counts, yet the resolution ended
+    /// the analysis, and the report says where (it said "every swing found is above it").
+    #[test]
+    fn regression_issue_16_resolution_ends_at_an_unclosed_last_swing() {
+        let q = std::f64::consts::TAU / 4096.0;
+        // Turning points of a decay losing 1.5 counts per half swing: 12, 10.5, …, 3, 1.5.
+        let amps: Vec<f64> = (0..8).map(|k| (12.0 - 1.5 * k as f64) * q).collect();
+        let fs = 1000.0;
+        let (mut t, mut th) = (Vec::new(), Vec::new());
+        let push = |t: &mut Vec<f64>, th: &mut Vec<f64>, v: f64| {
+            t.push(t.len() as f64 / fs);
+            th.push((v / q).floor() * q);
+        };
+        for _ in 0..300 {
+            push(&mut t, &mut th, amps[0]);
+        }
+        for k in 0..amps.len() - 1 {
+            let (a, b) = (
+                amps[k] * if k % 2 == 0 { 1.0 } else { -1.0 },
+                amps[k + 1] * if k % 2 == 0 { -1.0 } else { 1.0 },
+            );
+            for i in 0..500 {
+                let s = i as f64 / 500.0;
+                let v = 0.5 * (a + b) + 0.5 * (a - b) * (std::f64::consts::PI * s).cos();
+                push(&mut t, &mut th, v);
+            }
+        }
+        let rest = *amps.last().unwrap() * -1.0;
+        for _ in 0..3000 {
+            push(&mut t, &mut th, rest);
+        }
+        let env = envelope_with(&t, &th, Some(q)).expect("envelope");
+        let r = &env.resolution;
+        eprintln!("{}", r.describe());
+        let ended = r.ended_at_s.expect("the resolution ended the analysis");
+        // At the last turning point found, +3 counts at 3.3 s: the swing after it is 2.25.
+        assert!((ended - 3.3).abs() < 0.05, "ended at {ended} s");
+        let next = r.ended_swing_rad.expect("the swing that ended it") / q;
+        assert!((next - 2.25).abs() < 0.6, "{next} counts");
+        assert!(
+            r.describe()
+                .contains("the resolution ended the analysis at t ="),
+            "{}",
+            r.describe()
+        );
     }
 }

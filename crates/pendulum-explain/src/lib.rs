@@ -9,8 +9,9 @@ pub mod decay;
 mod linalg;
 
 pub use decay::{
-    diagnose_decay, envelope, first_swing, loss_band_contradicts, omega_n_estimate, turning_points,
-    turning_points_with, Candidate, Coef, DecayDiagnosis, DecayError, DecayOptions, EnvelopeFit,
-    EnvelopeRow, Estimate, HeldOutScore, KnownRig, LossBand, ModelFit, PeriodLaw, ReferenceModel,
-    Resolution, Term, TurningPoint, Unexplained, DECAY_RULE, LOSS_BAND_FACTOR, MIN_SWING_STEPS,
+    diagnose_decay, envelope, envelope_with, first_swing, loss_band_contradicts, omega_n_estimate,
+    turning_points, turning_points_with, Candidate, Coef, DecayDiagnosis, DecayError, DecayOptions,
+    EnvelopeFit, EnvelopeRow, Estimate, HeldOutScore, KnownRig, LossBand, ModelFit, PeriodLaw,
+    ReferenceModel, Resolution, Term, TurningPoint, Unexplained, DECAY_RULE, LOSS_BAND_FACTOR,
+    MIN_SWING_STEPS,
 };

@@ -15,7 +15,7 @@ use pendulum_process::{Role, RunData};
 
 use crate::inputs::Inputs;
 use crate::outputs::{prepare_out_dir, removed_note, write_outputs_checked, OutputSummary, TABLES};
-use crate::runs::load_runs_mixing;
+use crate::runs::{load_runs_mixing, load_runs_resolved_mixing};
 use crate::JobError;
 
 /// The built-in pipelines (the same text as `pipelines/*.toml`).
@@ -251,14 +251,25 @@ pub fn run(job: &IdentifyJob) -> Result<OutputSummary, JobError> {
     }
     let inputs = checked_inputs(inputs, &job.input, &job.out)?;
     let removed = prepare_out_dir(&job.out)?;
-    let runs: Vec<RunData> = load_runs_mixing(&job.input, job.overrides.mix_campaigns)?;
+    let (runs, steps): (Vec<RunData>, Vec<Option<f64>>) =
+        load_runs_resolved_mixing(&job.input, job.overrides.mix_campaigns)?
+            .into_iter()
+            .unzip();
     if !runs.iter().any(|r| r.role == Role::Identify) {
         return Err(JobError::Invalid(format!(
             "{}: no run has role = \"identify\"",
             job.input.display()
         )));
     }
+    // The stated resolutions (counts_per_rev) bound the free-decay envelope the fit is checked
+    // against, as in discover.
+    let resolutions = runs
+        .iter()
+        .zip(&steps)
+        .filter_map(|(r, s)| Some((r.id.clone(), (*s)?)))
+        .collect();
     let mut ctx = Context::new(runs);
+    ctx.resolutions = resolutions;
     ctx.notes.extend(removed_note(&removed));
     // The fit silently runs with at least MIN_NP members: say so, naming where np came from.
     if let Some(np) = pipeline

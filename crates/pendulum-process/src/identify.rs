@@ -465,7 +465,11 @@ pub fn params_at_bounds(runs: &[PreparedRun], out: &FitOutcome) -> Vec<String> {
     let mut notes = Vec::new();
     for ((p, &v), &(lo, hi)) in out.spec.params.iter().zip(&out.params).zip(&bounds) {
         let tol = 1e-3 * (hi - lo);
-        let at = if v <= lo + tol {
+        // A damping term's lower bound 0 is where a term the fit does not use ends up, to the
+        // optimiser's precision; 0.1 % of the span is no such thing: α = 4.2e-4 1/rad (a
+        // quadratic drag losing a tenth of the MultiArm decay's energy) was called unused.
+        let tol_low = if lo == 0.0 { 1e-6 * (hi - lo) } else { tol };
+        let at = if v <= lo + tol_low {
             Some(("lower", lo))
         } else if v >= hi - tol {
             Some(("upper", hi))
@@ -799,4 +803,558 @@ pub fn steady_from(
         [y0[0], y0[1] / k],
         k,
     )
+}
+
+/// The free-decay damping parameters and the loss term of the catalogue each one is.
+const DECAY_TERMS: [(FitParam, pendulum_explain::Term); 4] = [
+    (FitParam::Beta, pendulum_explain::Term::ViscousLinear),
+    (FitParam::Alpha, pendulum_explain::Term::ViscousQuadratic),
+    (FitParam::MBearing, pendulum_explain::Term::CoulombBearing),
+    (FitParam::DryC, pendulum_explain::Term::CoulombConstant),
+];
+
+/// The decay law's parts, as the envelope can tell them apart: its two dry terms have loss
+/// curves that differ only at large swings (the bearing load), so they are one part here and
+/// the fit's M + c is compared with whichever dry term the envelope kept.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum LawPart {
+    Viscous,
+    Quadratic,
+    Dry,
+}
+
+impl LawPart {
+    const ALL: [LawPart; 3] = [LawPart::Viscous, LawPart::Quadratic, LawPart::Dry];
+
+    fn of(t: pendulum_explain::Term) -> Option<LawPart> {
+        use pendulum_explain::Term;
+        match t {
+            Term::ViscousLinear => Some(LawPart::Viscous),
+            Term::ViscousQuadratic => Some(LawPart::Quadratic),
+            Term::CoulombBearing | Term::CoulombConstant => Some(LawPart::Dry),
+            Term::Stiffness => None,
+        }
+    }
+
+    fn name(self) -> &'static str {
+        match self {
+            LawPart::Viscous => "viscous",
+            LawPart::Quadratic => "quadratic drag",
+            LawPart::Dry => "dry friction",
+        }
+    }
+
+    /// The fit's parameters of this part, in the order a constraint is put on them.
+    fn params(self, spec: &ModelSpec) -> Vec<FitParam> {
+        DECAY_TERMS
+            .iter()
+            .filter(|(p, t)| LawPart::of(*t) == Some(self) && spec.params.contains(p))
+            .map(|(p, _)| *p)
+            .collect()
+    }
+
+    /// The fit's value of this part (M + c for dry friction); `None` when the model lacks it.
+    fn value(self, spec: &ModelSpec, x: &[f64]) -> Option<f64> {
+        let ps = self.params(spec);
+        (!ps.is_empty()).then(|| ps.iter().filter_map(|p| spec.value_of(*p, x)).sum())
+    }
+}
+
+/// Amplitude bands the measured loss per cycle is compared in (fewer when there are few cycles).
+const DECAY_LAW_BANDS: usize = 3;
+
+/// What the envelope of one free-decay run says, in the fit's window: the other view of the
+/// decay law, beside the trajectory fit (issue 16 item 1).
+struct RunEnvelope {
+    id: String,
+    env: pendulum_explain::EnvelopeFit,
+    bands: Vec<pendulum_explain::LossBand>,
+}
+
+impl RunEnvelope {
+    /// The envelope resolves `part` (a catalogue coefficient of it with its interval clear of
+    /// 0): the part's interval (the sum over both dry terms when it kept both), widened by
+    /// [`ENVELOPE_TOLERANCE`] of its estimate on either side.
+    fn resolved(&self, part: LawPart) -> Option<(f64, f64)> {
+        let coefs: Vec<&pendulum_explain::Coef> = self
+            .env
+            .catalogue
+            .iter()
+            .filter(|c| {
+                DECAY_TERMS
+                    .iter()
+                    .any(|(_, t)| t.name() == c.name && LawPart::of(*t) == Some(part))
+            })
+            .collect();
+        if !coefs.iter().any(|c| c.significant && c.ci_low > 0.0) {
+            return None;
+        }
+        let est: f64 = coefs.iter().map(|c| c.estimate).sum();
+        let lo: f64 = coefs.iter().map(|c| c.ci_low.max(0.0)).sum();
+        let hi: f64 = coefs.iter().map(|c| c.ci_high).sum();
+        let tol = ENVELOPE_TOLERANCE * est.abs();
+        Some(((lo - tol).max(0.0), hi + tol))
+    }
+}
+
+/// How far beyond the envelope's interval, as a fraction of its estimate, a trajectory fit's
+/// value still agrees with it: the fit has no interval of its own, and the envelope's loss
+/// curves and refined turning points are not exact (a noise-free twin's fit and envelope differ
+/// by about 1 %, their intervals by less).
+const ENVELOPE_TOLERANCE: f64 = 0.1;
+
+/// The envelope of a prepared free decay over the fit's window (the data the fit saw), with its
+/// measured loss per cycle in amplitude bands. `None` when the window holds too few swings.
+fn run_envelope(
+    run: &PreparedRun,
+    raw: Option<(&RunData, &Alignment)>,
+    resolution_rad: Option<f64>,
+) -> Option<RunEnvelope> {
+    if !run.free || !(run.omega0_rad_s > 0.0) {
+        return None;
+    }
+    // The recording itself over the window, where it is at hand: the fit's samples are
+    // decimated to 100 Hz, which hides the encoder's step (a large swing never shows one count
+    // between two of them) and so the resolution that ends the analysis.
+    let window_s = run.t.last().copied().unwrap_or(0.0) / run.omega0_rad_s;
+    let (t_s, theta): (Vec<f64>, Vec<f64>) = match raw {
+        Some((rd, al)) => {
+            let lo = rd.enc_t_s.partition_point(|&x| x < al.t0_s);
+            let hi = rd.enc_t_s.partition_point(|&x| x <= al.t0_s + window_s);
+            (rd.enc_t_s[lo..hi].to_vec(), rd.theta_rad[lo..hi].to_vec())
+        }
+        None => (
+            run.t.iter().map(|t| t / run.omega0_rad_s).collect(),
+            run.theta.clone(),
+        ),
+    };
+    let env = pendulum_explain::envelope_with(&t_s, &theta, resolution_rad).ok()?;
+    let mut rows: Vec<(f64, f64)> = env
+        .rows
+        .iter()
+        .filter_map(|r| Some((r.mid_amplitude_rad?, r.loss_per_cycle_rad?)))
+        .filter(|(a, l)| a.is_finite() && l.is_finite())
+        .collect();
+    rows.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let nb = DECAY_LAW_BANDS.min(rows.len() / 3).max(1);
+    let mut bands = Vec::new();
+    for k in 0..nb {
+        let part = &rows[k * rows.len() / nb..(k + 1) * rows.len() / nb];
+        if part.is_empty() {
+            continue;
+        }
+        let n = part.len() as f64;
+        let mean = part.iter().map(|r| r.1).sum::<f64>() / n;
+        let var = part.iter().map(|r| (r.1 - mean).powi(2)).sum::<f64>() / (n - 1.0).max(1.0);
+        bands.push(pendulum_explain::LossBand {
+            amplitude_from_rad: part[0].0,
+            amplitude_to_rad: part[part.len() - 1].0,
+            amplitude_mean_rad: part.iter().map(|r| r.0).sum::<f64>() / n,
+            cycles: part.len(),
+            measured_rad: mean,
+            measured_se_rad: (var / n).sqrt(),
+            base_model_rad: f64::NAN,
+            best_model_rad: f64::NAN,
+            best_terms: Vec::new(),
+        });
+    }
+    Some(RunEnvelope {
+        id: run.id.clone(),
+        env,
+        bands,
+    })
+}
+
+/// The loss per cycle, rad, that the fitted damping terms `x` imply at amplitude `a_rad`,
+/// leaving out `without` (the first-order loss curves of the catalogue, as the envelope uses).
+fn model_loss_per_cycle(spec: &ModelSpec, x: &[f64], a_rad: f64, without: Option<FitParam>) -> f64 {
+    DECAY_TERMS
+        .iter()
+        .filter(|(p, _)| Some(*p) != without)
+        .filter_map(|(p, t)| Some(spec.value_of(*p, x)? * t.loss_per_cycle(a_rad)))
+        .sum()
+}
+
+/// The bands whose measured loss per cycle the fitted model contradicts (see
+/// [`pendulum_explain::loss_band_contradicts`]), in words.
+fn contradicted_bands(re: &RunEnvelope, spec: &ModelSpec, x: &[f64], z: f64) -> Vec<String> {
+    re.bands
+        .iter()
+        .filter_map(|b| {
+            let model = model_loss_per_cycle(spec, x, b.amplitude_mean_rad, None);
+            pendulum_explain::loss_band_contradicts(b, model, z).then(|| {
+                format!(
+                    "A {:.4}–{:.4} rad: fit {model:.3e} rad/cycle, {:.2}× the measured {:.3e} ± {:.1e}",
+                    b.amplitude_from_rad,
+                    b.amplitude_to_rad,
+                    model / b.measured_rad,
+                    b.measured_rad,
+                    z * b.measured_se_rad
+                )
+            })
+        })
+        .collect()
+}
+
+/// `inner` with some parameters' boxes changed: a refit that the decay law constrains.
+struct Constrained<'a, 'b> {
+    inner: &'a StudyObjective<'b>,
+    bounds: Vec<(f64, f64)>,
+}
+
+impl pendulum_fit::Problem for Constrained<'_, '_> {
+    fn dim(&self) -> usize {
+        self.bounds.len()
+    }
+    fn bounds(&self) -> Vec<(f64, f64)> {
+        self.bounds.clone()
+    }
+    fn cost(&self, x: &[f64], bound: f64) -> pendulum_fit::Cost {
+        pendulum_fit::Problem::cost(self.inner, x, bound)
+    }
+}
+
+/// One decay law for free decays (issue 16 item 1): the trajectory fit `out` is checked
+/// against each run's envelope over the same window, and refitted (Nelder–Mead from the fit,
+/// within the changed boxes) where the two views contradict each other:
+///
+/// - a part of the law that the envelope resolves (its interval clear of 0) is not left outside
+///   the envelope's interval (widened by [`ENVELOPE_TOLERANCE`] of its estimate): a fit that
+///   calls a decay pure dry friction while the envelope measures a viscous part is refitted
+///   with the part inside it;
+/// - a term whose implied loss per cycle contradicts the measured one (beyond the measured
+///   interval widened by [`pendulum_explain::LOSS_BAND_FACTOR`]) while the model without it
+///   does not is never kept: it is fixed at 0.
+///
+/// Returns the (possibly refitted) outcome and one verdict per run with each view's evidence.
+/// Shaker runs pass through unchanged, with no notes.
+pub fn decay_law(
+    runs: &[PreparedRun],
+    ctx: &crate::pipeline::Context,
+    cfg: &FitConfig,
+    mut out: FitOutcome,
+) -> (FitOutcome, Vec<String>) {
+    const Z: f64 = 1.96;
+    if !out.spec.is_free_decay() || runs.iter().any(|r| !r.free) {
+        return (out, Vec::new());
+    }
+    let envs: Vec<Option<RunEnvelope>> = runs
+        .iter()
+        .map(|r| {
+            let rd = ctx.runs.iter().find(|d| d.id == r.id);
+            run_envelope(
+                r,
+                rd.zip(ctx.alignments.get(&r.id)),
+                ctx.resolutions.get(&r.id).copied(),
+            )
+        })
+        .collect();
+    let spec = out.spec.clone();
+    let objective = StudyObjective {
+        runs,
+        spec: &spec,
+        kappa: cfg.kappa,
+        sim: SimOptions::with_tol(cfg.sim_tol),
+        ic_halfwidth: cfg.ic_halfwidth,
+        fixed_params: None,
+        penalty: true,
+        order: Default::default(),
+    };
+    let mut bounds = objective.bounds_vec();
+    let n = spec.params.len();
+    let mut x: Vec<f64> = out.params.clone();
+    for rf in &out.runs {
+        x.extend(rf.ic_fit);
+    }
+    let index = |p: FitParam| spec.params.iter().position(|q| *q == p);
+    let mut actions = Vec::new();
+    // A part the envelope resolves, outside its interval in the fit (a decay called pure dry
+    // friction while the envelope measures a viscous part; viscous traded for a quadratic drag
+    // the envelope does not see): the part's box becomes the envelope's interval (common to
+    // every run that resolves it; none when they have nothing in common: the verdicts say so).
+    for part in LawPart::ALL {
+        let (lo, hi) = envs
+            .iter()
+            .flatten()
+            .filter_map(|e| e.resolved(part))
+            .fold((f64::NEG_INFINITY, f64::INFINITY), |a, b| {
+                (a.0.max(b.0), a.1.min(b.1))
+            });
+        let (Some(v), Some(&p)) = (part.value(&spec, &x[..n]), part.params(&spec).first()) else {
+            continue;
+        };
+        let Some(k) = index(p) else { continue };
+        if !(lo.is_finite() && hi.is_finite() && lo <= hi) || (lo..=hi).contains(&v) {
+            continue;
+        }
+        // The other parameters of the part (c beside M) stay as fitted.
+        let others = v - x[k];
+        let (b_lo, b_hi) = (
+            (lo - others).max(bounds[k].0),
+            (hi - others).min(bounds[k].1),
+        );
+        if !(b_lo < b_hi) {
+            continue;
+        }
+        actions.push(format!(
+            "{} {} = {v:.3e} was outside the envelope's interval [{lo:.3e}, {hi:.3e}]: refitted \
+             with {} in [{b_lo:.3e}, {b_hi:.3e}]",
+            part.name(),
+            p.name(),
+            p.name()
+        ));
+        bounds[k] = (b_lo, b_hi);
+        x[k] = x[k].clamp(b_lo, b_hi);
+    }
+    // A term whose loss per cycle contradicts the measured one, where the model without it does
+    // not, is vetoed.
+    for &(p, t) in &DECAY_TERMS {
+        let Some(k) = index(p) else { continue };
+        if !(x[k] > 0.0) || bounds[k].0 > 0.0 || bounds[k].1 < objective.bounds_vec()[k].1 {
+            continue;
+        }
+        let vetoed = envs.iter().flatten().any(|e| {
+            e.bands.iter().any(|b| {
+                let a = b.amplitude_mean_rad;
+                pendulum_explain::loss_band_contradicts(
+                    b,
+                    model_loss_per_cycle(&spec, &x[..n], a, None),
+                    Z,
+                ) && !pendulum_explain::loss_band_contradicts(
+                    b,
+                    model_loss_per_cycle(&spec, &x[..n], a, Some(p)),
+                    Z,
+                )
+            })
+        });
+        if vetoed {
+            actions.push(format!(
+                "{} {} = {:.3e} implies a loss per cycle the envelope contradicts: fixed at 0",
+                t.name(),
+                p.name(),
+                x[k]
+            ));
+            // A box of zero width is not one: a sliver above 0 (the term is then nothing).
+            bounds[k] = (0.0, 1e-12 * bounds[k].1.max(1e-300));
+            x[k] = 0.0;
+        }
+    }
+    if !actions.is_empty() {
+        let problem = Constrained {
+            inner: &objective,
+            bounds: bounds.clone(),
+        };
+        let step: Vec<f64> = bounds.iter().map(|(lo, hi)| 0.05 * (hi - lo)).collect();
+        let (xr, _, _) = pendulum_fit::nelder_mead(&problem, &x, &step, 2000, 1e-6);
+        let eval = objective.evaluate(&xr);
+        // Runs sharing one fit may each resolve a different law over their own amplitudes: a
+        // constraint that makes the fit contradict more of the measured losses than it did is
+        // not the decay law of these runs together (fit them separately).
+        let contradictions = |p: &[f64]| -> usize {
+            envs.iter()
+                .flatten()
+                .map(|e| contradicted_bands(e, &spec, p, Z).len())
+                .sum()
+        };
+        let (before, after) = (contradictions(&out.params), contradictions(&xr[..n]));
+        if after > before {
+            notes_refused(&mut actions, before, after, out.e_theta, eval.e_theta);
+        } else {
+            actions.push(format!(
+                "E_θ {:.4} → {:.4} under the decay law",
+                out.e_theta, eval.e_theta
+            ));
+            out.params = xr[..n].to_vec();
+            out.f_obj = eval.f_obj;
+            out.e_theta = eval.e_theta;
+            for (j, rf) in out.runs.iter_mut().enumerate() {
+                rf.ic_fit = [xr[n + 2 * j], xr[n + 2 * j + 1]];
+                rf.e_theta = eval.per_run_e[j];
+                rf.segment_e = eval.per_run_segment_e[j].clone();
+                rf.simulated = eval.per_run_sim_steady[j];
+            }
+        }
+    }
+    let fitted: Vec<String> = DECAY_TERMS
+        .iter()
+        .filter_map(|(p, t)| {
+            Some(format!(
+                "{} {} = {:.3e}",
+                t.name(),
+                p.name(),
+                spec.value_of(*p, &out.params)?
+            ))
+        })
+        .collect();
+    let mut notes = Vec::new();
+    for (run, re) in runs.iter().zip(&envs) {
+        let Some(re) = re else {
+            notes.push(format!(
+                "decay law, run {}: no envelope in the fit's window (too few swings): the \
+                 trajectory fit is the only view",
+                run.id
+            ));
+            continue;
+        };
+        let cat: Vec<String> = re
+            .env
+            .catalogue
+            .iter()
+            .map(|c| {
+                format!(
+                    "{} {:.3e} [{:.3e}, {:.3e}]{}",
+                    c.name,
+                    c.estimate,
+                    c.ci_low,
+                    c.ci_high,
+                    if c.significant { "" } else { " (not resolved)" }
+                )
+            })
+            .collect();
+        let bands: Vec<String> = re
+            .bands
+            .iter()
+            .map(|b| {
+                format!(
+                    "A {:.4} rad: measured {:.3e} ± {:.1e}, fit {:.3e}",
+                    b.amplitude_mean_rad,
+                    b.measured_rad,
+                    Z * b.measured_se_rad,
+                    model_loss_per_cycle(&spec, &out.params, b.amplitude_mean_rad, None)
+                )
+            })
+            .collect();
+        // One verdict: the views agree when every part the envelope resolves is within its
+        // interval (widened by ENVELOPE_TOLERANCE) in the fit and no band's measured loss is
+        // contradicted.
+        let below: Vec<String> = LawPart::ALL
+            .iter()
+            .filter_map(|part| {
+                let (lo, hi) = re.resolved(*part)?;
+                match part.value(&spec, &out.params) {
+                    Some(v) if (lo..=hi).contains(&v) => None,
+                    Some(v) => Some(format!(
+                        "{} {v:.3e} outside the envelope's [{lo:.3e}, {hi:.3e}]",
+                        part.name()
+                    )),
+                    None => Some(format!(
+                        "{} resolved ([{lo:.3e}, {hi:.3e}]) but not in the model",
+                        part.name()
+                    )),
+                }
+            })
+            .collect();
+        let contradicted = contradicted_bands(re, &spec, &out.params, Z);
+        let verdict = if below.is_empty() && contradicted.is_empty() {
+            "verdict: the views agree".to_string()
+        } else {
+            format!(
+                "verdict: the views disagree ({})",
+                below
+                    .iter()
+                    .chain(&contradicted)
+                    .cloned()
+                    .collect::<Vec<_>>()
+                    .join("; ")
+            )
+        };
+        notes.push(format!(
+            "decay law, run {}: envelope ({}): {}; fit: {}; loss per cycle: {}; {}; {verdict}",
+            re.id,
+            re.env.shape,
+            if cat.is_empty() {
+                "no term resolved".to_string()
+            } else {
+                cat.join(", ")
+            },
+            fitted.join(", "),
+            bands.join("; "),
+            re.env.resolution.describe(),
+        ));
+    }
+    if !actions.is_empty() {
+        notes.push(format!(
+            "decay law, fit {}: {}",
+            spec.name,
+            actions.join("; ")
+        ));
+    }
+    (out, notes)
+}
+
+/// The refit under the decay law's constraints was worse for the measured losses: kept out.
+fn notes_refused(actions: &mut Vec<String>, before: usize, after: usize, e0: f64, e1: f64) {
+    actions.push(format!(
+        "refit not taken: it contradicts the measured loss per cycle in {after} amplitude bands \
+         (the fit {before}; E_θ {e0:.4} → {e1:.4}): the runs' envelopes do not share one decay \
+         law (fit them separately)"
+    ));
+}
+
+/// Per-run ω0 and hanging angle (issue 16 item 4): free decays whose own ω0 differ (see
+/// [`shared_omega0_notes`]) are also fitted one by one, each with its own ω0, its own swing
+/// centre (`encoder_offset`: the hanging angle) and its own damping, so that the report gives
+/// every run the values its swings say beside the forced shared fit. Each fit goes through the
+/// run's [`decay_law`] (with `ctx`), whose refit notes, if any, come with it. Empty when the runs
+/// agree (or are one run, or not free decays).
+pub fn per_run_fits(
+    runs: &[PreparedRun],
+    ctx: &crate::pipeline::Context,
+    cfg: &FitConfig,
+    shared: &FitOutcome,
+) -> Result<Vec<(FitOutcome, Vec<String>)>, ProcessError> {
+    if shared_omega0_notes(runs, shared).is_empty() {
+        return Ok(Vec::new());
+    }
+    runs.iter()
+        .map(|r| {
+            let one = std::slice::from_ref(r);
+            let (fit, notes) = decay_law(one, ctx, cfg, identify(one, cfg, None)?);
+            // The run's verdict is stated once, for the shared fit; the refit's note stays.
+            let refit = notes
+                .into_iter()
+                .filter(|n| n.starts_with("decay law, fit"))
+                .map(|n| format!("{} alone: {n}", r.id))
+                .collect();
+            Ok((fit, refit))
+        })
+        .collect()
+}
+
+/// One note per run of [`per_run_fits`]: its own ω0, hanging angle and damping, E_θ against the
+/// shared fit's on that run, and its parameters at a bound.
+pub fn per_run_notes(
+    runs: &[PreparedRun],
+    shared: &FitOutcome,
+    fits: &[(FitOutcome, Vec<String>)],
+) -> Vec<String> {
+    let mut notes = Vec::new();
+    for (run, (fit, refit)) in runs.iter().zip(fits) {
+        let values: Vec<String> = fit
+            .spec
+            .params
+            .iter()
+            .zip(&fit.params)
+            .map(|(p, v)| format!("{} = {v:.4e}", p.name()))
+            .collect();
+        let shared_e = shared
+            .runs
+            .iter()
+            .find(|r| r.id == run.id)
+            .map_or(f64::NAN, |r| r.e_theta);
+        notes.push(format!(
+            "fit {} per run, {} alone (its own omega0 and hanging angle): {}; E_θ {:.4} (shared fit: {shared_e:.4})",
+            fit.spec.name,
+            run.id,
+            values.join(", "),
+            fit.e_theta
+        ));
+        notes.extend(refit.iter().cloned());
+        notes.extend(
+            params_at_bounds(std::slice::from_ref(run), fit)
+                .into_iter()
+                .map(|n| format!("{} alone: {n}", run.id)),
+        );
+    }
+    notes
 }

@@ -51,6 +51,9 @@ pub struct Context {
     /// show the residual the fit minimised).
     pub fit_window: Option<crate::identify::Window>,
     pub validate_window: Option<crate::identify::Window>,
+    /// Each run's angle resolution, rad, where its capture states it (`counts_per_rev`): it
+    /// bounds the free-decay envelope the fit is checked against.
+    pub resolutions: BTreeMap<String, f64>,
 }
 
 impl Context {
@@ -280,8 +283,15 @@ impl Stage for FitStage {
         let runs = ctx.prepared(Role::Identify, &self.0.window, self.name())?;
         ctx.fit_window = Some(self.0.window);
         let out = identify(&runs, &self.0, ctx.progress.clone())?;
+        // Free decays: the fit and the envelope reach one verdict (issue 16 item 1).
+        let (out, law) = crate::identify::decay_law(&runs, ctx, &self.0, out);
+        ctx.notes.extend(law);
         ctx.notes
             .extend(crate::identify::shared_omega0_notes(&runs, &out));
+        // Free decays that do not share ω0 also get their own fits, reported per run.
+        let alone = crate::identify::per_run_fits(&runs, ctx, &self.0, &out)?;
+        ctx.notes
+            .extend(crate::identify::per_run_notes(&runs, &out, &alone));
         ctx.notes
             .extend(crate::identify::params_at_bounds(&runs, &out));
         ctx.fits.push(out);

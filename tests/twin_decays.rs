@@ -1,0 +1,140 @@
+//! Issue 16 "done when", on twins: free decays with viscous drag and bearing friction, a bob of
+//! drawn mass and length, a 4096-count encoder and time stamps in bursts (a host stamping each
+//! serial read of ~62 ms alike), through `pendulum identify`: every run gets one decay-law
+//! verdict in which the trajectory fit and the envelope agree, the time base is rebuilt, and
+//! the fitted damping is the simulated one (the decay law the twin was made with).
+
+use std::path::Path;
+
+use rand::{RngExt, SeedableRng};
+
+/// The twin's sample rate, Hz, and the host's read period, ms.
+const RATE_HZ: f64 = 200.0;
+const READ_MS: f64 = 62.0;
+const COUNTS_PER_REV: f64 = 4096.0;
+
+/// The drawn design and its identifiable damping (β = b/(m ω0), M = μ r_b/l).
+struct Twin {
+    m_kg: f64,
+    l_m: f64,
+    beta: f64,
+    m_bearing: f64,
+}
+
+/// A free decay from the model's simulator, written as counts with bursty stamps.
+fn twin_run(dir: &Path, seed: u64) -> Twin {
+    use pendulum_model::{Model, Physical, SimOptions};
+    let mut r = rand_chacha::ChaCha8Rng::seed_from_u64(0x16_0000 + seed);
+    let phys = Physical {
+        m_kg: r.random_range(0.745..1.46),
+        l_m: r.random_range(0.17..0.27),
+        crank_r_m: 0.0,
+        r_b_m: 0.01225,
+        a_kg_m: 0.0,
+        b_n_s_m: r.random_range(0.05..0.2),
+        mu: r.random_range(0.02..0.05),
+        ..Physical::default()
+    };
+    let theta0: f64 = r.random_range(0.6..1.2);
+    let w0 = phys.omega0_rad_s();
+    let duration_s = 40.0;
+    let tr = pendulum_model::sim::simulate(
+        &Model::new(phys.to_dimensionless()),
+        &SimOptions::default(),
+        [theta0, 0.0],
+        0.0,
+        duration_s * w0,
+        w0 / RATE_HZ,
+    )
+    .expect("simulate");
+    let mut csv = String::from("host_ms\tcount\n");
+    let (mut read_ms, mut k) = (READ_MS, 0u64);
+    let mut i = 0usize;
+    while i < tr.theta.len() {
+        while i < tr.theta.len() && i as f64 * 1e3 / RATE_HZ <= read_ms {
+            let count = (tr.theta[i] * COUNTS_PER_REV / std::f64::consts::TAU).floor();
+            csv.push_str(&format!("{read_ms:.0}\t{count}\n"));
+            i += 1;
+        }
+        k += 1;
+        // The host's read period: 62 ms ± 4 ms, reproducible.
+        read_ms += READ_MS + 8.0 * (((k * 7919 + seed) % 101) as f64 / 100.0 - 0.5);
+    }
+    std::fs::write(dir.join("twin.tsv"), csv).expect("write twin");
+    let toml = format!(
+        "name = \"twin-{seed}\"\n[rig]\nm_kg = {:.4}\nl_m = {:.4}\nr_b_m = 0.01225\n\
+         format = \"timeseries\"\ntime_column = \"host_ms\"\ntime_unit = \"ms\"\n\
+         angle_column = \"count\"\nangle_unit = \"counts\"\ncounts_per_rev = {COUNTS_PER_REV}\n\
+         role = \"identify\"\n[[run]]\nid = \"twin{seed}\"\nfile = \"twin.tsv\"\n",
+        phys.m_kg, phys.l_m
+    );
+    std::fs::write(dir.join("campaign.toml"), toml).expect("write campaign");
+    let twin = Twin {
+        m_kg: phys.m_kg,
+        l_m: phys.l_m,
+        beta: phys.b_n_s_m / (phys.m_kg * w0),
+        m_bearing: phys.mu * phys.r_b_m / phys.l_m,
+    };
+    eprintln!(
+        "twin {seed}: m {:.3} kg, l {:.4} m, θ0 {theta0:.3} rad, beta {:.3e}, M {:.3e}",
+        twin.m_kg, twin.l_m, twin.beta, twin.m_bearing
+    );
+    twin
+}
+
+/// The value of `name = v` in a line of `pendulum identify`'s model summary.
+fn fitted(text: &str, name: &str) -> f64 {
+    let line = text
+        .lines()
+        .find(|l| l.starts_with("model "))
+        .expect("model line");
+    line.split_whitespace()
+        .find_map(|w| w.strip_prefix(&format!("{name}=")))
+        .and_then(|v| v.parse().ok())
+        .unwrap_or_else(|| panic!("{name} not in {line}"))
+}
+
+#[test]
+fn regression_issue_16_twin_decays_one_decay_law() {
+    let tmp = tempfile::tempdir().expect("temp dir");
+    for seed in [1u64, 2, 3] {
+        let camp = tmp.path().join(format!("camp{seed}"));
+        std::fs::create_dir_all(&camp).expect("campaign dir");
+        let twin = twin_run(&camp, seed);
+        let out = tmp.path().join(format!("out{seed}"));
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_pendulum"))
+            .args(["identify", "--quiet", "--model", "reference", "--out"])
+            .arg(&out)
+            .arg(&camp)
+            .output()
+            .expect("run pendulum identify");
+        let text = String::from_utf8_lossy(&o.stdout).into_owned();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(o.status.success(), "{text}\n{err}");
+        print!("{text}{err}");
+        let verdict = text
+            .lines()
+            .find(|l| l.starts_with(&format!("note: decay law, run twin{seed}:")))
+            .unwrap_or_else(|| panic!("no verdict:\n{text}"));
+        assert!(
+            verdict.ends_with("verdict: the views agree"),
+            "twin {seed}: {verdict}"
+        );
+        assert!(
+            verdict.contains("stated"),
+            "resolution not the stated one: {verdict}"
+        );
+        // The decay law the twin was made with.
+        let (beta, m) = (fitted(&text, "beta"), fitted(&text, "M"));
+        assert!(
+            (beta - twin.beta).abs() < 0.2 * twin.beta,
+            "twin {seed}: beta {beta} vs {}",
+            twin.beta
+        );
+        assert!(
+            (m - twin.m_bearing).abs() < 0.2 * twin.m_bearing,
+            "twin {seed}: M {m} vs {}",
+            twin.m_bearing
+        );
+    }
+}
