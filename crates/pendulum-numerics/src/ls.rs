@@ -150,7 +150,11 @@ pub fn inverse_spd(a: &[f64], n: usize) -> Result<Vec<f64>, NumericsError> {
 
 /// Cholesky of the Jacobi-scaled `a`: the solution of `a x = b` (when `b` is given) and a⁻¹.
 #[allow(clippy::type_complexity)]
-fn spd(a: &[f64], b: Option<&[f64]>, n: usize) -> Result<(Option<Vec<f64>>, Vec<f64>), NumericsError> {
+fn spd(
+    a: &[f64],
+    b: Option<&[f64]>,
+    n: usize,
+) -> Result<(Option<Vec<f64>>, Vec<f64>), NumericsError> {
     if a.len() != n * n {
         return Err(NumericsError::Shape {
             what: "matrix",
