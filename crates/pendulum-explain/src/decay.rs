@@ -50,7 +50,7 @@ use std::ops::ControlFlow;
 use pendulum_model::{integrate, Dimensionless, Excitation, Model, ModelError, SimOptions};
 use serde::{Deserialize, Serialize};
 
-use crate::linalg::{inverse_spd, ols, solve_spd};
+use pendulum_numerics::{bic, inverse_spd, median, solve_spd, LsFit};
 
 /// Errors of the free-decay analysis.
 #[derive(Debug, thiserror::Error)]
@@ -640,17 +640,13 @@ fn check_input(t: &[f64], th: &[f64]) -> Result<(), DecayError> {
     Ok(())
 }
 
-fn median(v: &mut [f64]) -> f64 {
-    if v.is_empty() {
-        return f64::NAN;
+/// Ordinary least squares for the loss-per-cycle fits, `None` unless there are more points
+/// than terms: an exact fit through as many points as terms would win every BIC comparison.
+fn ols(rows: &[Vec<f64>], y: &[f64]) -> Option<LsFit> {
+    if rows.len() <= rows.first()?.len() {
+        return None;
     }
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        0.5 * (v[n / 2 - 1] + v[n / 2])
-    }
+    pendulum_numerics::ols(rows, y).ok()
 }
 
 /// The angle's step q and where it comes from: `stated` (2π / counts per revolution) when the
@@ -918,7 +914,7 @@ fn refine(t: &[f64], th: &[f64], i: usize, w: f64, sign: i8) -> ((f64, f64, usiz
             }
         }
         let a = [s[0], s[1], s[2], s[1], s[2], s[3], s[2], s[3], s[4]];
-        let Some(c) = solve_spd(&a, &b, 3) else {
+        let Ok(c) = solve_spd(&a, &b, 3) else {
             return best;
         };
         // θ = c0 + c1 u + c2 u²
@@ -1200,11 +1196,6 @@ fn coef(name: &str, est: f64, var: f64, z: f64, unit: &str) -> Coef {
     }
 }
 
-fn bic(rss: f64, n: usize, k: usize) -> f64 {
-    let n = n as f64;
-    n * (rss.max(1e-300) / n).ln() + k as f64 * n.ln()
-}
-
 /// The envelope of a free decay: turning points, loss per cycle against amplitude, and its
 /// shape.
 pub fn envelope(t_s: &[f64], theta_rad: &[f64]) -> Result<EnvelopeFit, DecayError> {
@@ -1282,7 +1273,7 @@ fn envelope_of(
     let names = ["c0", "c1", "c2"];
     let units = ["rad", "1", "1/rad"];
     let basis = |a: f64, j: usize| a.powi(j as i32);
-    let fit_subset = |sub: &[usize]| -> Option<(Vec<f64>, Vec<f64>, f64)> {
+    let fit_subset = |sub: &[usize]| -> Option<LsFit> {
         let rows: Vec<Vec<f64>> = pts
             .iter()
             .map(|p| sub.iter().map(|&j| basis(p.0, j)).collect())
@@ -1297,13 +1288,19 @@ fn envelope_of(
             .collect()
     };
     let polynomial = match fit_subset(&[0, 1, 2]) {
-        Some((b, c, _)) => to_coefs(&[0, 1, 2], &b, &c),
+        Some(f) => to_coefs(&[0, 1, 2], &f.coef, &f.cov),
         None => Vec::new(),
     };
     let subsets: [&[usize]; 7] = [&[0], &[1], &[2], &[0, 1], &[0, 2], &[1, 2], &[0, 1, 2]];
     let mut best: Option<(f64, Vec<Coef>)> = None;
     for sub in subsets {
-        if let Some((b, c, rss)) = fit_subset(sub) {
+        if let Some(LsFit {
+            coef: b,
+            cov: c,
+            rss,
+            ..
+        }) = fit_subset(sub)
+        {
             let cols: Vec<Vec<f64>> = sub
                 .iter()
                 .map(|&j| pts.iter().map(|p| basis(p.0, j)).collect())
@@ -1345,7 +1342,13 @@ fn envelope_of(
             .iter()
             .map(|p| sub.iter().map(|t| t.loss_per_cycle(p.0)).collect())
             .collect();
-        let Some((b, c, rss)) = ols(&rows, &y) else {
+        let Some(LsFit {
+            coef: b,
+            cov: c,
+            rss,
+            ..
+        }) = ols(&rows, &y)
+        else {
             continue;
         };
         if b.iter().any(|v| *v <= 0.0) {
@@ -1678,7 +1681,7 @@ impl<'a> Decay<'a> {
                             gg[i] = 0.0;
                         }
                     }
-                    let Some(dl) = solve_spd(&aa, &gg, p) else {
+                    let Ok(dl) = solve_spd(&aa, &gg, p) else {
                         break;
                     };
                     let mut changed = false;
@@ -1758,8 +1761,8 @@ impl<'a> Decay<'a> {
         }
         let s2 = out.rss / (n.saturating_sub(p)).max(1) as f64;
         let cov = match inverse_spd(&a, p) {
-            Some(inv) => inv.iter().map(|v| v * s2 * tau).collect(),
-            None => vec![f64::INFINITY; p * p],
+            Ok(inv) => inv.iter().map(|v| v * s2 * tau).collect(),
+            Err(_) => vec![f64::INFINITY; p * p],
         };
         let t_from = segs.first().map_or(f64::NAN, |s| s.t0);
         let t_to = segs
@@ -2064,7 +2067,7 @@ pub fn diagnose_decay(
             .collect();
         let y: Vec<f64> = pts.iter().map(|p| p.1).collect();
         match ols(&rows, &y) {
-            Some((b, _, _)) => b.iter().map(|v| v.max(0.0) * 0.7 + 1e-6).collect(),
+            Some(f) => f.coef.iter().map(|v| v.max(0.0) * 0.7 + 1e-6).collect(),
             None => vec![1e-4; terms.len()],
         }
     };

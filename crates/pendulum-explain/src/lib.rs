@@ -6,7 +6,6 @@
 //! unit inertia), candidate terms with intervals and held-out gains, and what stays unexplained.
 
 pub mod decay;
-mod linalg;
 
 pub use decay::{
     diagnose_decay, envelope, envelope_with, first_swing, loss_band_contradicts, omega_n_estimate,

@@ -1003,9 +1003,10 @@ pub fn pooled_envelope(
         if x.iter().flatten().any(|v| !v.is_finite()) {
             continue;
         }
-        let Some((b, cov, rms)) = pendulum_process::linalg::lstsq(&x, &y) else {
+        let Ok(fit) = pendulum_numerics::ols(&x, &y) else {
             continue;
         };
+        let (b, cov) = (&fit.coef, &fit.cov);
         let m = sub.len();
         let terms: Vec<PooledTerm> = sub
             .iter()
@@ -1024,8 +1025,7 @@ pub fn pooled_envelope(
         if terms.iter().any(|t| t.ci_low <= 0.0) {
             continue;
         }
-        let n = pts.len() as f64;
-        let bic = n * (rms * rms).max(1e-300).ln() + m as f64 * n.ln();
+        let bic = pendulum_numerics::bic(fit.rss, pts.len(), m);
         if best.as_ref().is_none_or(|(s, _)| bic < *s) {
             best = Some((bic, terms));
         }

@@ -20,6 +20,7 @@
 
 use std::ops::ControlFlow;
 
+use pendulum_numerics::trapezoid_weight;
 use serde::{Deserialize, Serialize};
 
 use crate::sim::{integrate, Model, SimOptions};
@@ -129,8 +130,7 @@ pub fn mean_powers(
         let tq = model.torques(s.t, s.theta, s.theta_dot);
         let w = s.theta_dot;
         let excess = (w.abs() - p.gen_w).max(0.0);
-        // Trapezoid weights: half at both ends.
-        let wt = if i == 0 || i == n { 0.5 * dt } else { dt };
+        let wt = trapezoid_weight(i, n, dt);
         acc.base += wt * tq.base * w;
         acc.viscous -= wt * tq.viscous * w;
         acc.quadratic -= wt * tq.quadratic * w;

@@ -7,6 +7,7 @@ use std::fmt;
 use std::ops::ControlFlow;
 use std::str::FromStr;
 
+use pendulum_numerics::wrap_pi;
 use serde::{Deserialize, Serialize};
 
 use crate::sim::{integrate, Model, SimOptions};
@@ -111,12 +112,6 @@ impl Default for ClassifyOptions {
             rest_tol: 1e-4,
         }
     }
-}
-
-fn wrap_pi(x: f64) -> f64 {
-    let two_pi = 2.0 * std::f64::consts::PI;
-    let y = (x + std::f64::consts::PI).rem_euclid(two_pi);
-    y - std::f64::consts::PI
 }
 
 /// Classifies Poincaré points (θ unwrapped, θ̇), one per forcing period, transient removed.

@@ -17,9 +17,9 @@
 //! sqrt(g/l) is wrong for a physical pendulum and m, l may be unknown.
 
 use pendulum_model::excitation::{crank_f1, crank_f2};
+use pendulum_numerics::{inverse_spd, median, ols, solve_spd, wls};
 use serde::{Deserialize, Serialize};
 
-use crate::linalg::{inverse, solve};
 use crate::run::RunData;
 use crate::ProcessError;
 
@@ -230,19 +230,6 @@ fn f3(phi: f64, lambda: f64) -> f64 {
     (crank_f2(phi + h, lambda) - crank_f2(phi - h, lambda)) / (2.0 * h)
 }
 
-fn median(v: &mut [f64]) -> f64 {
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    if n == 0 {
-        return f64::NAN;
-    }
-    if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        0.5 * (v[n / 2 - 1] + v[n / 2])
-    }
-}
-
 /// Aligns one run (see the module docs).
 pub fn align(run: &RunData, cfg: &AlignConfig) -> Result<Alignment, ProcessError> {
     cfg.validate()?;
@@ -371,9 +358,9 @@ pub fn align(run: &RunData, cfg: &AlignConfig) -> Result<Alignment, ProcessError
         let n = idx.len() as f64;
         rms = (ss / n).sqrt();
         let delta =
-            solve(&jtj, &jtr, 4).ok_or_else(|| fail("the crank-model fit is singular".into()))?;
+            solve_spd(&jtj, &jtr, 4).map_err(|_| fail("the crank-model fit is singular".into()))?;
         let s2 = ss / (n - 4.0).max(1.0);
-        if let Some(inv) = inverse(&jtj, 4) {
+        if let Ok(inv) = inverse_spd(&jtj, 4) {
             for (c, v) in cov.iter_mut().zip(inv) {
                 *c = v * s2;
             }
@@ -412,7 +399,7 @@ pub fn align(run: &RunData, cfg: &AlignConfig) -> Result<Alignment, ProcessError
                 vec![1.0, x, x * x]
             })
             .collect();
-        let (b, _, _) = crate::linalg::lstsq(&rows, &az[lo..hi])?;
+        let b = ols(&rows, &az[lo..hi]).ok()?.coef;
         // Vertex of the parabola if it lies in the window, else the value at the predicted peak.
         let peak = if b[2] < 0.0 && (b[1] / (2.0 * b[2])).abs() <= 1.0 {
             b[0] - b[1] * b[1] / (4.0 * b[2])
@@ -484,28 +471,16 @@ impl PhaseTrack {
         if n < 6 {
             return None;
         }
-        let mut ata = [0.0; 9];
-        let mut atb = [0.0; 3];
-        for i in 0..n {
-            let w = 1.0 / self.phase_sigma_rad[i].powi(2).max(1e-300);
-            let x = [1.0, self.tau_s[i], self.tau_s[i] * self.tau_s[i]];
-            for a in 0..3 {
-                atb[a] += w * x[a] * self.phase_rad[i];
-                for b in 0..3 {
-                    ata[a * 3 + b] += w * x[a] * x[b];
-                }
-            }
-        }
-        let c = solve(&ata, &atb, 3)?;
-        let inv = inverse(&ata, 3)?;
-        let chi2: f64 = (0..n)
-            .map(|i| {
-                let tau = self.tau_s[i];
-                let e = self.phase_rad[i] - (c[0] + c[1] * tau + c[2] * tau * tau);
-                (e / self.phase_sigma_rad[i]).powi(2)
-            })
-            .sum();
-        let red = (chi2 / (n as f64 - 3.0)).max(1.0);
+        let rows: Vec<[f64; 3]> = self.tau_s.iter().map(|&t| [1.0, t, t * t]).collect();
+        let w: Vec<f64> = self
+            .phase_sigma_rad
+            .iter()
+            .map(|s| 1.0 / s.powi(2).max(1e-300))
+            .collect();
+        // Inverse-variance weights: the weighted RSS is the χ², (XᵀWX)⁻¹ the covariance.
+        let fit = wls(&rows, &self.phase_rad, &w).ok()?;
+        let (c, inv) = (fit.coef, fit.cov_unscaled);
+        let red = (fit.rss / (n as f64 - 3.0)).max(1.0);
         Some((
             [c[0], c[1], c[2]],
             [inv[0] * red, inv[4] * red, inv[8] * red],
@@ -587,9 +562,11 @@ pub fn track_crank_phase(run: &RunData, al: &Alignment) -> Option<PhaseTrack> {
                     }
                 }
             }
-            let Some(d) = solve(&jtj, &jtr, 4) else { break };
+            let Ok(d) = solve_spd(&jtj, &jtr, 4) else {
+                break;
+            };
             let s2 = ss / ((hi - lo) as f64 - 4.0);
-            cov00 = inverse(&jtj, 4).map_or(f64::NAN, |inv| inv[0] * s2);
+            cov00 = inverse_spd(&jtj, 4).map_or(f64::NAN, |inv| inv[0] * s2);
             for (pk, dk) in p.iter_mut().zip(&d) {
                 *pk += dk;
             }
@@ -715,9 +692,9 @@ pub fn fit_speed_drift(run: &RunData, al: &Alignment) -> Option<DriftFit> {
         }
         let n = idx.len() as f64;
         rms = (ss / n).sqrt();
-        let delta = solve(&jtj, &jtr, 5)?;
+        let delta = solve_spd(&jtj, &jtr, 5).ok()?;
         let s2 = ss / (n - 5.0);
-        if let Some(inv) = inverse(&jtj, 5) {
+        if let Ok(inv) = inverse_spd(&jtj, 5) {
             for (c, v) in cov.iter_mut().zip(inv) {
                 *c = v * s2;
             }

@@ -2,9 +2,9 @@
 //! difference, which would amplify the encoder's quantisation), with uncertainties; and the
 //! encoder zero checked against the hanging position from the free decay's turning points.
 
+use pendulum_numerics::ols;
 use serde::{Deserialize, Serialize};
 
-use crate::linalg::lstsq;
 use crate::run::RunData;
 use crate::ProcessError;
 
@@ -84,10 +84,11 @@ pub fn estimate_state(
             (0..=cfg.order).map(|p| x.powi(p as i32)).collect()
         })
         .collect();
-    let (b, cov, _) = lstsq(&rows, &th[lo..hi]).ok_or_else(|| ProcessError::Run {
+    let fit = ols(&rows, &th[lo..hi]).map_err(|_| ProcessError::Run {
         run: run.id.clone(),
         reason: format!("singular initial-condition fit at t = {t_s:.4} s"),
     })?;
+    let (b, cov) = (fit.coef, fit.cov);
     let n = cfg.order + 1;
     // Quantisation (uniform, 2π/4096) is a floor on the residual variance.
     let q2 = (2.0 * std::f64::consts::PI / 4096.0).powi(2) / 12.0;

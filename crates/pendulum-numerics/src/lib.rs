@@ -1,0 +1,14 @@
+//! Numerical helpers shared by the workspace, at its bottom (no workspace dependencies): one
+//! least-squares routine with one result type, the Student-t / F / normal quantiles and tails
+//! (from `statrs`, not hand-typed tables or approximations), one BIC, one median, one angle
+//! wrap and one trapezoid rule. A routine needed by two crates lives here, once.
+
+mod error;
+mod ls;
+mod misc;
+mod stats;
+
+pub use error::NumericsError;
+pub use ls::{inverse_spd, ols, solve_spd, wls, LsFit};
+pub use misc::{median, trapezoid, trapezoid_weight, wrap_pi};
+pub use stats::{bic, f_sf, normal_quantile, normal_sf, t_quantile};
