@@ -519,17 +519,12 @@ fn trajectory_substitution(
 /// fundamental by −0.06 %), not the effect `accel_gain`.
 pub const ACCEL_GAIN_FLOOR: f64 = 0.01;
 
-/// Two-sided 95 % quantile of Student's t with `df` degrees of freedom.
+/// Two-sided 95 % quantile of Student's t with `df` degrees of freedom (infinite at 0).
 fn t95(df: usize) -> f64 {
-    const T: [f64; 10] = [
-        12.706, 4.303, 3.182, 2.776, 2.571, 2.447, 2.365, 2.306, 2.262, 2.228,
-    ];
-    match df {
-        0 => f64::INFINITY,
-        1..=10 => T[df - 1],
-        11..=20 => 2.2,
-        21..=40 => 2.05,
-        _ => 1.96,
+    if df == 0 {
+        f64::INFINITY
+    } else {
+        pendulum_numerics::t_quantile(0.975, df as f64)
     }
 }
 
@@ -1165,33 +1160,7 @@ fn anova(key: &[f64], res: &[f64], bins: usize) -> Option<(f64, f64)> {
     }
     let (d1, d2) = ((bins - 1) as f64, (n - bins) as f64);
     let f = (ssb / d1) / (ssw / d2).max(1e-300);
-    // Wilson–Hilferty: (F·d1/d2)^(1/3) approximately normal.
-    let a = 2.0 / (9.0 * d1);
-    let b = 2.0 / (9.0 * d2);
-    let z = ((1.0 - b) * f.cbrt() - (1.0 - a)) / (b * f.powf(2.0 / 3.0) + a).sqrt();
-    let p = 0.5 * erfc(z / std::f64::consts::SQRT_2);
-    Some((f, p))
-}
-
-fn erfc(x: f64) -> f64 {
-    // Numerical Recipes' erfc approximation (relative error < 1.2e-7).
-    let z = x.abs();
-    let t = 1.0 / (1.0 + 0.5 * z);
-    let r = t
-        * (-z * z - 1.26551223
-            + t * (1.00002368
-                + t * (0.37409196
-                    + t * (0.09678418
-                        + t * (-0.18628806
-                            + t * (0.27886807
-                                + t * (-1.13520398
-                                    + t * (1.48851587 + t * (-0.82215223 + t * 0.17087277)))))))))
-            .exp();
-    if x >= 0.0 {
-        r
-    } else {
-        2.0 - r
-    }
+    Some((f, pendulum_numerics::f_sf(f, d1, d2)))
 }
 
 /// Runs discovery on a context whose pipeline has aligned the runs, estimated initial states and

@@ -6,7 +6,6 @@
 //! stepwise) so that pairs of effects are separated: after the best, the next must improve BIC
 //! again with the first already in.
 
-use pendulum_process::linalg::{inverse, solve};
 use serde::{Deserialize, Serialize};
 
 use crate::weak::{
@@ -144,8 +143,7 @@ pub struct Ols {
 
 impl Ols {
     pub fn bic(&self) -> f64 {
-        let n = self.n as f64;
-        n * (self.rss / n).max(1e-300).ln() + self.columns.len() as f64 * n.ln()
+        pendulum_numerics::bic(self.rss, self.n, self.columns.len())
     }
 
     /// Coefficient of a column.
@@ -260,7 +258,7 @@ fn weighted_se(
         return None;
     }
     let (scale, ata, _) = normal_equations(rows, p, col);
-    let inv = inverse(&ata, p)?;
+    let inv = pendulum_numerics::inverse_spd(&ata, p).ok()?;
     let s2 = rss / (n - p) as f64;
     Some(
         (0..p)
@@ -315,7 +313,7 @@ fn ols_at(rows: &[WeakRow], columns: &[usize], inertia_kg_m2: f64) -> Option<Ols
     let beta = if p == 0 {
         Vec::new()
     } else {
-        solve(&ata, &atb, p)?
+        pendulum_numerics::solve_spd(&ata, &atb, p).ok()?
     };
     let mut rss = 0.0;
     for r in rows {
@@ -326,7 +324,7 @@ fn ols_at(rows: &[WeakRow], columns: &[usize], inertia_kg_m2: f64) -> Option<Ols
     let inv = if p == 0 {
         Vec::new()
     } else {
-        inverse(&ata, p)?
+        pendulum_numerics::inverse_spd(&ata, p).ok()?
     };
     Some(Ols {
         columns: columns.to_vec(),

@@ -310,16 +310,14 @@ fn wls(x: &[Vec<f64>], y: &[f64], w: &[f64], cols: &[usize]) -> Option<(Vec<f64>
         })
         .collect();
     let b: Vec<f64> = y.iter().zip(w).map(|(v, wi)| v * wi.sqrt()).collect();
-    let (coef, cov, rms) = pendulum_process::linalg::lstsq(&a, &b)?;
+    let fit = pendulum_numerics::ols(&a, &b).ok()?;
     let p = cols.len();
-    let coef: Vec<f64> = coef.iter().zip(&scale).map(|(c, s)| c / s).collect();
-    let se: Vec<f64> = (0..p)
-        .map(|i| cov[i * p + i].max(0.0).sqrt() / scale[i])
-        .collect();
+    let coef: Vec<f64> = fit.coef.iter().zip(&scale).map(|(c, s)| c / s).collect();
+    let se: Vec<f64> = (0..p).map(|i| fit.se(i) / scale[i]).collect();
     if coef.iter().any(|c| !c.is_finite()) {
         return None;
     }
-    Some((coef, se, rms * rms * n as f64))
+    Some((coef, se, fit.rss))
 }
 
 /// Fits a sparse description of `residual` (one per row; the identify rows fit it, the validate
@@ -538,8 +536,7 @@ pub fn family_beats_candidate(
         .collect();
     let y: Vec<f64> = id_rows.iter().map(|r| r.target).collect();
     let w: Vec<f64> = id_rows.iter().map(|r| r.weight).collect();
-    let nf = y.len() as f64;
-    let bic = |rss: f64, k: usize| nf * (rss / nf).max(1e-300).ln() + k as f64 * nf.ln();
+    let bic = |rss: f64, k: usize| pendulum_numerics::bic(rss, y.len(), k);
     let base: Vec<usize> = (0..nc).collect();
     let cand: Vec<usize> = (0..nc + ne).collect();
     let cand_bic = bic(wls(&design, &y, &w, &cand)?.2, cand.len());
@@ -569,8 +566,7 @@ fn forward_select(
     base: &[usize],
     pool: &[usize],
 ) -> Option<(Vec<usize>, f64)> {
-    let nf = y.len() as f64;
-    let bic = |rss: f64, k: usize| nf * (rss / nf).max(1e-300).ln() + k as f64 * nf.ln();
+    let bic = |rss: f64, k: usize| pendulum_numerics::bic(rss, y.len(), k);
     let base_rss = if base.is_empty() {
         y.iter().zip(w).map(|(v, wi)| wi * v * v).sum()
     } else {

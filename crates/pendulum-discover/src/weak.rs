@@ -390,8 +390,8 @@ pub fn weak_rows(run_idx: usize, run: &RunData, al: &Alignment, cfg: &WeakConfig
                     vec![1.0, x, x * x, x * x * x]
                 })
                 .collect();
-            if let Some((c, _, _)) = pendulum_process::linalg::lstsq(&rows_x, &win) {
-                thd[i] = Some(c[1] / (hd as f64 * dt));
+            if let Ok(fit) = pendulum_numerics::ols(&rows_x, &win) {
+                thd[i] = Some(fit.coef[1] / (hd as f64 * dt));
             }
         }
         let half = (hw / dt).round() as usize;

@@ -7,7 +7,6 @@ pub mod fit;
 mod free_tests;
 pub mod ic;
 pub mod identify;
-pub mod linalg;
 pub mod measured;
 pub mod pipeline;
 pub mod run;
