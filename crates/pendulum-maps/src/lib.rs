@@ -24,6 +24,7 @@
 pub mod bifurcation;
 pub mod ics;
 pub mod params_file;
+pub mod power;
 pub mod shard;
 pub mod style;
 pub mod sweep;
