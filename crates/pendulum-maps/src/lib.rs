@@ -22,6 +22,7 @@
 //! the number of threads.
 
 pub mod bifurcation;
+pub mod design;
 pub mod ics;
 pub mod params_file;
 pub mod power;
