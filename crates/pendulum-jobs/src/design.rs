@@ -46,6 +46,7 @@ pub struct DesignArgs {
     #[arg(
         long = "omega-hz",
         value_name = "LIST",
+        allow_hyphen_values = true,
         default_value = "0.87,1.18,1.54,1.92,2.36"
     )]
     pub omega_hz: String,
@@ -53,24 +54,35 @@ pub struct DesignArgs {
     #[arg(
         long = "crank-r-m",
         value_name = "LIST",
+        allow_hyphen_values = true,
         default_value = "0.0725,0.1065"
     )]
     pub crank_r_m: String,
     /// Generator loads c_g = k_e²/R to search, N·m·s/rad (default 0.01,0.02,0.04,0.08,0.16).
-    #[arg(long = "c-g", value_name = "LIST")]
+    #[arg(long = "c-g", value_name = "LIST", allow_hyphen_values = true)]
     pub c_g: Option<String>,
     /// Generator dead bands ω_d = V_d/k_e to search, rad/s (default 0,2); every pair with --c-g.
-    #[arg(long = "omega-d", value_name = "LIST")]
+    #[arg(long = "omega-d", value_name = "LIST", allow_hyphen_values = true)]
     pub omega_d: Option<String>,
     /// The load given electrically instead: generator EMF constants k_e, V·s/rad; every
     /// combination with --v-d and --r-ohm is a load (c_g = k_e²/R, ω_d = V_d/k_e).
-    #[arg(long = "k-e", value_name = "LIST", conflicts_with_all = ["c_g", "omega_d"], requires_all = ["v_d", "r_ohm"])]
+    #[arg(long = "k-e", value_name = "LIST", allow_hyphen_values = true, conflicts_with_all = ["c_g", "omega_d"], requires_all = ["v_d", "r_ohm"])]
     pub k_e: Option<String>,
     /// Rectifier diode drops V_d, V (with --k-e).
-    #[arg(long = "v-d", value_name = "LIST", requires = "k_e")]
+    #[arg(
+        long = "v-d",
+        value_name = "LIST",
+        allow_hyphen_values = true,
+        requires = "k_e"
+    )]
     pub v_d: Option<String>,
     /// Load resistances R, Ω (with --k-e).
-    #[arg(long = "r-ohm", value_name = "LIST", requires = "k_e")]
+    #[arg(
+        long = "r-ohm",
+        value_name = "LIST",
+        allow_hyphen_values = true,
+        requires = "k_e"
+    )]
     pub r_ohm: Option<String>,
     #[command(flatten)]
     pub ics: IcArgs,
