@@ -1,5 +1,5 @@
 //! Maps split over machines: the `--shard` option every map command shares (`bifurcate`,
-//! `zones`, and `design` when it comes), what a shard run writes and prints, and
+//! `zones`, `design`), what a shard run writes and prints, and
 //! `pendulum merge DIR`, which checks the shards and writes the table and figures exactly as the
 //! one-machine run would (see `pendulum_maps::shard`).
 
