@@ -21,7 +21,7 @@ struct Cli {
 
 #[derive(clap::Subcommand)]
 enum Cmd {
-    Design(DesignArgs),
+    Design(Box<DesignArgs>),
     Merge(MergeArgs),
 }
 
