@@ -6,7 +6,7 @@
 //!   `(i_Ω·n_r + i_r)·n_load + i_load` (the load varies fastest), the unit a sharded run deals out
 //!   ([`crate::shard`]), and the table lists model by model, cell by cell, like `zones`.
 //! * Each start is simulated past its transient and its steady state classified; its mean powers
-//!   over the recorded whole periods come from `pendulum_model::power` ([`crate::power`]). The
+//!   over one orbit of its steady state come from `pendulum_model::power` ([`crate::power`]). The
 //!   cell reports the mean over the starts (the **expected** power when the starting state is
 //!   unknown), their spread, standard error and worst start, and the fraction that rotate.
 //! * Physical axes, because a designer buys a crank and a generator, not a dimensionless R: the
@@ -685,7 +685,7 @@ pub fn plot_curves(designs: &[Design], path: &Path) -> Result<(), MapsError> {
         panels: vec![
             Panel {
                 title: format!(
-                    "expected power into the load at Ω = {} Hz, r = {} m, ω_d = {} rad/s: mean and ± one standard error over {} starts (last {} of {} + {} periods)",
+                    "expected power into the load at Ω = {} Hz, r = {} m, ω_d = {} rad/s: mean and ± one standard error over {} starts (classified over the last {} of {} + {} periods, powers over one orbit)",
                     fmt_num(best.omega_hz),
                     fmt_num(best.crank_r_m),
                     fmt_num(best.load.omega_d_rad_s),
@@ -834,7 +834,7 @@ pub fn summary_markdown(designs: &[Design]) -> String {
     };
     let cfg = &first.config;
     s.push_str(&format!(
-        "Searched {} crank speeds × {} crank radii × {} generator loads = {} operating points per model, {} starts each, mean powers over the last {} of {} + {} forcing periods.\n\n",
+        "Searched {} crank speeds × {} crank radii × {} generator loads = {} operating points per model, {} starts each, classified over the last {} of {} + {} forcing periods, mean powers over one orbit of each start's steady state (all recorded periods when chaotic).\n\n",
         cfg.omega_hz.len(),
         cfg.crank_r_m.len(),
         cfg.loads.len(),

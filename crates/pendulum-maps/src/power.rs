@@ -2,6 +2,13 @@
 //! reports the mean powers of [`pendulum_model::power::mean_powers`] (the one power integrator;
 //! nothing here integrates) over the whole forcing periods its class is read from, in W.
 //!
+//! The window: the first recorded forcing periods, as many as the steady state's own period (a
+//! period-p orbit repeats after p forcing periods, so its mean over p periods is its mean over
+//! any whole number of orbits; rest takes 1), or the whole recorded window for chaos, whose mean
+//! only a long window estimates. Why not always the whole window: `mean_powers` samples 2000
+//! points per period, which over 50 recorded periods made a map 4.6 times slower (`cargo bench
+//! --bench maps -- generator`); one orbit costs a few per cent.
+//!
 //! Why the window starts at the first Poincaré point instead of re-running from t = 0: the
 //! transient is most of a map's cost, and the state at t = transient·T is known exactly (it is
 //! the first recorded point). The powers are those of the motion from that state, which is the
@@ -9,7 +16,7 @@
 
 use pendulum_model::power::mean_powers;
 use pendulum_model::steady::steady_state_of;
-use pendulum_model::{ClassifyOptions, MeanPowers, Model, SimOptions, SteadyState};
+use pendulum_model::{ClassifyOptions, MeanPowers, Model, SimOptions, SteadyClass, SteadyState};
 use pendulum_report::Column;
 
 use crate::MapsError;
@@ -18,7 +25,7 @@ use crate::MapsError;
 pub const POWER_COLUMNS: [(&str, &str); 8] = [
     (
         "mean_power_base_w",
-        "mean power the base's motion feeds the pendulum over the recorded whole periods, W",
+        "mean power the base's motion feeds the pendulum over one orbit of the steady state (p forcing periods; chaos: all recorded periods), W",
     ),
     (
         "mean_power_viscous_w",
@@ -50,8 +57,16 @@ pub const POWER_COLUMNS: [(&str, &str); 8] = [
     ),
 ];
 
-/// A simulation's steady state, its Poincaré points and its mean powers in W over the
-/// recorded periods (`scale_w` = m g l ω0 of the rig).
+/// Forcing periods the powers are averaged over (see the module docs).
+pub fn power_periods(st: &SteadyState, record_periods: u32) -> u32 {
+    match st.class {
+        SteadyClass::Chaos => record_periods,
+        _ => st.period.clamp(1, record_periods.max(1)),
+    }
+}
+
+/// A simulation's steady state, its Poincaré points and its mean powers in W over
+/// [`power_periods`] from the first recorded point (`scale_w` = m g l ω0 of the rig).
 pub fn steady_with_power(
     model: &Model,
     sim: &SimOptions,
@@ -72,7 +87,7 @@ pub fn steady_with_power(
     )?;
     let period = model.params.forcing_period();
     let t_from = f64::from(transient_periods) * period;
-    let t_to = t_from + f64::from(record_periods) * period;
+    let t_to = t_from + f64::from(power_periods(&st, record_periods)) * period;
     let (Some(&th0), Some(&w0)) = (th.first(), thd.first()) else {
         return Err(MapsError::Invalid("no Poincaré point recorded".into()));
     };

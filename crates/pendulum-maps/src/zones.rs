@@ -297,7 +297,7 @@ impl ZoneMap {
         save_heatmaps_side_by_side(
             &[load, base],
             &format!(
-                "Power, {}: {} starts per cell, mean over the last {} of {} + {} periods (rig m g l ω0 = {} W)",
+                "Power, {}: {} starts per cell, classified over the last {} of {} + {} periods, powers over one orbit (rig m g l ω0 = {} W)",
                 self.describe(),
                 self.config.starts.len(),
                 self.config.record_periods,
