@@ -669,7 +669,7 @@ pub fn plot_curves(designs: &[Design], path: &Path) -> Result<(), MapsError> {
         });
     }
     let title = format!(
-        "Harvester design, {}: c_g = {} N·m·s/rad, ω_d = {} rad/s at Ω = {} Hz, r = {} m gives {} W ± {} W",
+        "Design, {}: c_g = {} N·m·s/rad, ω_d = {} rad/s, Ω = {} Hz, r = {} m: {} W ± {} W",
         designs[0].model.label,
         fmt_num(best.load.c_g_nm_s_rad),
         fmt_num(best.load.omega_d_rad_s),
@@ -679,20 +679,14 @@ pub fn plot_curves(designs: &[Design], path: &Path) -> Result<(), MapsError> {
         fmt_w(best.load_power_se_w()),
     );
     Figure {
-        width: 1400.max(title.chars().count() as u32 * 16 + 80).min(4000),
+        width: 1400.max(title.chars().count() as u32 * 21 + 100).min(4000),
         height: 900,
         title,
         panels: vec![
             Panel {
                 title: format!(
-                    "expected power into the load at Ω = {} Hz, r = {} m, ω_d = {} rad/s: mean and ± one standard error over {} starts (classified over the last {} of {} + {} periods, powers over one orbit)",
-                    fmt_num(best.omega_hz),
-                    fmt_num(best.crank_r_m),
-                    fmt_num(best.load.omega_d_rad_s),
+                    "power into the load at the optimum's Ω, r, ω_d: mean ± one standard error over {} starts",
                     best.starts,
-                    designs[0].config.record_periods,
-                    designs[0].config.transient_periods,
-                    designs[0].config.record_periods,
                 ),
                 x_label: "generator load c_g = k_e²/R (N·m·s/rad)".into(),
                 y_label: "mean electrical power into the load (W)".into(),
