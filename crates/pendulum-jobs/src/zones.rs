@@ -112,6 +112,23 @@ impl std::fmt::Display for ZonesSummary {
                     b.y
                 )?;
             }
+            // The harvester's answer when the model has a generator: its best cell, in W.
+            let most_power = m
+                .cells
+                .iter()
+                .filter(|x| x.mean_power_w.load.is_finite())
+                .max_by(|a, b| a.mean_power_w.load.total_cmp(&b.mean_power_w.load));
+            if let Some(p) = most_power.filter(|p| p.mean_power_w.load > 0.0) {
+                write!(
+                    f,
+                    "; most power into the load: {:.4} W (mean over the starts) at {} = {}, {} = {}",
+                    p.mean_power_w.load,
+                    c.x.param.name(),
+                    p.x,
+                    c.y.param.name(),
+                    p.y
+                )?;
+            }
             writeln!(f)?;
         }
         if let (Some(cmp), [a, b]) = (&self.comparison, self.maps.as_slice()) {
