@@ -18,6 +18,13 @@
 //! baseline's data pages. CPU/wall below the number of processes running at once means other
 //! processes had the cores (the load average is printed). `-- shards` runs this part alone,
 //! `-- threads` the first.
+//!
+//! Then the generator (issue 15 item 5): forcing periods per core-second of a map's simulations
+//! (ω 0.5..3.5 step 0.1 × 16 starts, 300 + 50 periods, the reference model, one thread) as the
+//! maps run them now, steady state and mean powers (`pendulum_maps::power`), without the
+//! generator (the baseline) and with it (k_e = 0.3 V·s/rad, V_d = 1.4 V, R = 5 Ω on the study's
+//! rig); and the steady state alone (what a map cost before it reported powers). Best of 3
+//! interleaved rounds, ratios against the baseline. `-- generator` runs this part alone.
 
 use std::time::Instant;
 
@@ -181,13 +188,102 @@ fn shards() {
 fn main() {
     let only: Vec<String> = std::env::args()
         .skip(1)
-        .filter(|a| a == "shards" || a == "threads")
+        .filter(|a| a == "shards" || a == "threads" || a == "generator")
         .collect();
     if only.is_empty() || only.iter().any(|a| a == "threads") {
         threads();
     }
     if only.is_empty() || only.iter().any(|a| a == "shards") {
         shards();
+    }
+    if only.is_empty() || only.iter().any(|a| a == "generator") {
+        generator();
+    }
+}
+
+fn generator() {
+    use pendulum_model::{ClassifyOptions, Model, Physical, SimOptions};
+    let phys = Physical::default();
+    let base = study("reference");
+    let mut with_gen = base;
+    // k_e = 0.3 V·s/rad, V_d = 1.4 V, R = 5 Ω: c_g = k_e²/R, ω_d = V_d/k_e, made dimensionless
+    // as the catalogue does (T/(m g l) with θ' = ω0 θ̇).
+    let (c_g, w_d) = (0.3f64 * 0.3 / 5.0, 1.4 / 0.3);
+    with_gen.gen_c = c_g * phys.omega0_rad_s() / phys.torque_scale_nm();
+    with_gen.gen_w = w_d / phys.omega0_rad_s();
+    let sweep = Sweep::parse("omega=0.5:3.5:0.1").expect("sweep");
+    let starts = IcSpec::parse_grid("4x4", 3.0).expect("grid").starts();
+    let (transient, record) = (300u32, 50u32);
+    let periods = (sweep.len() * starts.len()) as f64 * f64::from(transient + record);
+    let sim = SimOptions::with_tol(1e-8);
+    let classify = ClassifyOptions::default();
+    let scale = phys.power_scale_w();
+    let load = std::fs::read_to_string("/proc/loadavg").unwrap_or_default();
+    println!(
+        "\nmaps with and without the generator: ω 0.5..3.5 step 0.1 ({} values) × {} starts, {transient} + {record} periods = {periods:.0} forcing periods per run, one thread; load average {}",
+        sweep.len(),
+        starts.len(),
+        load.split_whitespace().take(3).collect::<Vec<_>>().join(" ")
+    );
+    // (label, parameters, with powers)
+    let runs: [(&str, pendulum_model::Dimensionless, bool); 3] = [
+        ("no generator, steady state + powers (baseline)", base, true),
+        ("generator, steady state + powers", with_gen, true),
+        (
+            "no generator, steady state alone (before powers)",
+            base,
+            false,
+        ),
+    ];
+    let rounds: usize = std::env::var("PENDULUM_BENCH_ROUNDS")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(3)
+        .max(1);
+    let mut best = [f64::INFINITY; 3];
+    let mut load_w = [0.0f64; 3];
+    for _ in 0..rounds {
+        for (k, (_, d, powers)) in runs.iter().enumerate() {
+            let c0 = cpu_s().unwrap_or(0.0);
+            let t0 = Instant::now();
+            let mut total_load = 0.0;
+            for i in 0..sweep.len() {
+                let model = Model::new(sweep.apply(d, i));
+                for &y0 in &starts {
+                    if *powers {
+                        let (_, _, _, pw) = pendulum_maps::power::steady_with_power(
+                            &model, &sim, y0, transient, record, &classify, scale,
+                        )
+                        .expect("simulation");
+                        total_load += pw.load;
+                    } else {
+                        pendulum_model::steady::steady_state_of(
+                            &model, &sim, y0, 0.0, transient, record, &classify,
+                        )
+                        .expect("simulation");
+                    }
+                }
+            }
+            // CPU time when /proc has it (other processes' load does not count), else wall.
+            let cpu = cpu_s().map_or(t0.elapsed().as_secs_f64(), |c| c - c0);
+            best[k] = best[k].min(cpu.max(1e-9));
+            load_w[k] = total_load / (sweep.len() * starts.len()) as f64;
+        }
+    }
+    println!("(best of {rounds} interleaved rounds)");
+    println!("run                                                 CPU [s]   periods/core-s   vs baseline   mean load power [W]");
+    for (k, (label, _, powers)) in runs.iter().enumerate() {
+        println!(
+            "{label:<50} {:>9.2} {:>16.0} {:>13.2} {:>21}",
+            best[k],
+            periods / best[k],
+            best[0] / best[k],
+            if *powers {
+                format!("{:.3}", load_w[k])
+            } else {
+                "-".to_string()
+            }
+        );
     }
 }
 

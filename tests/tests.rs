@@ -1,6 +1,7 @@
 //! The integration test binary: one module per area (ripgrep-style). Unit tests live inline.
 
 mod cli;
+mod design;
 mod discover;
 mod hostile;
 mod identify;

@@ -36,7 +36,10 @@ enum Command {
     Bifurcate(pendulum_jobs::bifurcate::BifurcateArgs),
     /// Rotation-zone maps over two swept parameters, two models compared: Parquet and PNGs.
     Zones(pendulum_jobs::zones::ZonesArgs),
-    /// Merge the shards of a map (`bifurcate`/`zones --shard I/N --out DIR`) into the table and
+    /// Harvester design: the generator load and operating point (crank speed, crank radius) that
+    /// maximise the expected power into the load for a fitted model, a second model beside it.
+    Design(pendulum_jobs::design::DesignArgs),
+    /// Merge the shards of a map (`bifurcate`/`zones`/`design --shard I/N --out DIR`) into the table and
     /// figures the one-machine run writes; refuses missing shards and mixed configurations.
     Merge(pendulum_jobs::merge::MergeArgs),
     /// Replay a run with a fitted model: measured channels plus /sim/theta in one MCAP file.
@@ -370,6 +373,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         }
         Command::Bifurcate(a) => out!("{}", pendulum_jobs::bifurcate::run(&a)?),
         Command::Zones(a) => out!("{}", pendulum_jobs::zones::run(&a)?),
+        Command::Design(a) => out!("{}", pendulum_jobs::design::run(&a)?),
         Command::Merge(a) => out!("{}", pendulum_jobs::merge::run(&a)?),
         Command::Replay(a) => out!("{}", pendulum_jobs::replay::run(&a)?),
         Command::Demo(a) => {

@@ -410,6 +410,7 @@ pub fn run(a: &BifurcateArgs) -> Result<Ran<BifurcateSummary>, JobError> {
     cfg.sim = a.run.sim()?;
     cfg.classify = ClassifyOptions::default();
     cfg.threads = a.run.threads;
+    cfg.power_scale_w = model.physical.power_scale_w();
     cfg.validate()?;
     let shard = a.shard.resolve()?;
     // Before the sweep: none of the outputs may replace the --params file.

@@ -4,6 +4,7 @@
 
 pub mod bifurcate;
 pub mod demo;
+pub mod design;
 pub mod discover;
 pub mod identify;
 pub mod ingest;

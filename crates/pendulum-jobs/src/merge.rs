@@ -1,5 +1,5 @@
 //! Maps split over machines: the `--shard` option every map command shares (`bifurcate`,
-//! `zones`, and `design` when it comes), what a shard run writes and prints, and
+//! `zones`, `design`), what a shard run writes and prints, and
 //! `pendulum merge DIR`, which checks the shards and writes the table and figures exactly as the
 //! one-machine run would (see `pendulum_maps::shard`).
 
@@ -13,6 +13,7 @@ use pendulum_report::{Column, TableOptions};
 use serde::{Deserialize, Serialize};
 
 use crate::bifurcate::BifurcateSummary;
+use crate::design::DesignSummary;
 use crate::zones::ZonesSummary;
 use crate::JobError;
 
@@ -118,6 +119,14 @@ pub struct ZonesModel {
 pub struct ZonesJob {
     pub config: ZoneConfig,
     pub models: Vec<ZonesModel>,
+    pub ic_description: String,
+}
+
+/// What a design shard records for the merge.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct DesignJob {
+    pub config: pendulum_maps::design::DesignConfig,
+    pub models: Vec<pendulum_maps::design::DesignModel>,
     pub ic_description: String,
 }
 
@@ -240,6 +249,55 @@ pub(crate) fn zones_shard(
     })
 }
 
+/// Runs shard `shard` of a design search and writes it into `out/shard=i/`.
+pub(crate) fn design_shard(
+    job: &DesignJob,
+    table_metadata: &[(String, String)],
+    shard: Shard,
+    out: &Path,
+    show_progress: bool,
+) -> Result<ShardSummary, JobError> {
+    use pendulum_maps::design;
+    let cfg = &job.config;
+    let total = cfg.cells();
+    check_count("design", shard, total, cfg.cell_description())?;
+    let cells = shard.cells(total);
+    crate::bifurcate::create_dir(&out.join(shard.dir_name()))?;
+    let sims = (cells.len() * cfg.starts.len() * job.models.len()) as u64;
+    let bar = crate::bifurcate::progress_bar(sims, "design shard", show_progress);
+    let t = std::time::Instant::now();
+    let designs = design::run_cells(&job.models, cfg, &cells, &|n| bar.inc(n))?;
+    bar.finish_and_clear();
+    let wall_s = t.elapsed().as_secs_f64();
+    let mut recorded = job.clone();
+    recorded.config.threads = None;
+    let written = shard::write_shard(
+        out,
+        &ShardPart {
+            command: "design",
+            shard,
+            cell: cfg.cell_description(),
+            cells_total: total,
+            cells: &cells,
+            // `best` needs the whole grid: false here, set by the merge.
+            columns: &design::columns(&designs, false),
+            table_metadata,
+            job: to_json(&recorded)?,
+            wall_s,
+        },
+    )?;
+    Ok(ShardSummary {
+        command: "design".into(),
+        shard,
+        cells: cells.len(),
+        cells_total: total,
+        simulations: sims,
+        wall_s,
+        out: out.to_path_buf(),
+        written,
+    })
+}
+
 /// `pendulum merge` options.
 #[derive(Debug, Clone, clap::Args)]
 pub struct MergeArgs {
@@ -255,6 +313,7 @@ pub struct MergeArgs {
 pub enum Merged {
     Bifurcate(Box<BifurcateSummary>),
     Zones(Box<ZonesSummary>),
+    Design(Box<DesignSummary>),
 }
 
 /// What `pendulum merge` did.
@@ -285,6 +344,7 @@ impl std::fmt::Display for MergeSummary {
         match &self.merged {
             Merged::Bifurcate(s) => s.fmt(f),
             Merged::Zones(s) => s.fmt(f),
+            Merged::Design(s) => s.fmt(f),
         }
     }
 }
@@ -358,9 +418,23 @@ pub fn run(a: &MergeArgs) -> Result<MergeSummary, JobError> {
                 figures,
             }))
         }
+        "design" => {
+            let job: DesignJob =
+                serde_json::from_value(first.job.clone()).map_err(|e| decode("design", e))?;
+            let (designs, columns) =
+                pendulum_maps::design::merge_shards(&job.models, &job.config, &set)?;
+            let s = crate::design::write_outputs(
+                &designs,
+                &columns,
+                &first.table_metadata,
+                &out,
+                wall_sum_s,
+            )?;
+            Merged::Design(Box::new(s))
+        }
         other => {
             return Err(JobError::Invalid(format!(
-            "{}: shards of command {other:?}, which this pendulum cannot merge (bifurcate, zones)",
+            "{}: shards of command {other:?}, which this pendulum cannot merge (bifurcate, zones, design)",
             a.dir.display()
         )))
         }

@@ -112,6 +112,23 @@ impl std::fmt::Display for ZonesSummary {
                     b.y
                 )?;
             }
+            // The harvester's answer when the model has a generator: its best cell, in W.
+            let most_power = m
+                .cells
+                .iter()
+                .filter(|x| x.mean_power_w.load.is_finite())
+                .max_by(|a, b| a.mean_power_w.load.total_cmp(&b.mean_power_w.load));
+            if let Some(p) = most_power.filter(|p| p.mean_power_w.load > 0.0) {
+                write!(
+                    f,
+                    "; most power into the load: {:.4} W (mean over the starts) at {} = {}, {} = {}",
+                    p.mean_power_w.load,
+                    c.x.param.name(),
+                    p.x,
+                    c.y.param.name(),
+                    p.y
+                )?;
+            }
             writeln!(f)?;
         }
         if let (Some(cmp), [a, b]) = (&self.comparison, self.maps.as_slice()) {
@@ -191,11 +208,17 @@ pub(crate) fn write_figures(
         let p = out.join(format!("zones_{}.png", slug(&m.label)));
         m.plot(&p)?;
         figures.push(p);
+        let p = out.join(format!("zones_power_{}.png", slug(&m.label)));
+        m.plot_power(&p)?;
+        figures.push(p);
     }
     let comparison = match maps {
         [a, b] => {
             let p = out.join("zones_compare.png");
             let cmp = zones::plot_comparison(a, b, &p)?;
+            figures.push(p);
+            let p = out.join("zones_power_compare.png");
+            zones::plot_power_comparison(a, b, &p)?;
             figures.push(p);
             Some(cmp)
         }
@@ -270,6 +293,8 @@ pub fn run(a: &ZonesArgs) -> Result<Ran<ZonesSummary>, JobError> {
     cfg.record_periods = a.run.record;
     cfg.sim = a.run.sim()?;
     cfg.threads = a.run.threads;
+    // Watts on the first model's rig (a fitted model's own m, l, g), for both models alike.
+    cfg.power_scale_w = models[0].physical.power_scale_w();
     let shard = a.shard.resolve()?;
     // Before the maps: none of the outputs may replace the --params file.
     let mut inputs = Inputs::new();
@@ -281,14 +306,19 @@ pub fn run(a: &ZonesArgs) -> Result<Ran<ZonesSummary>, JobError> {
             .iter()
             .map(|n| a.out.join(s.dir_name()).join(n))
             .collect(),
-        None => vec![a.out.join("zones.parquet"), a.out.join("zones_compare.png")],
+        None => vec![
+            a.out.join("zones.parquet"),
+            a.out.join("zones_compare.png"),
+            a.out.join("zones_power_compare.png"),
+        ],
     };
     if shard.is_none() {
-        outputs.extend(
-            models
-                .iter()
-                .map(|m| a.out.join(format!("zones_{}.png", slug(&m.label)))),
-        );
+        outputs.extend(models.iter().flat_map(|m| {
+            [
+                a.out.join(format!("zones_{}.png", slug(&m.label))),
+                a.out.join(format!("zones_power_{}.png", slug(&m.label))),
+            ]
+        }));
     }
     for p in &outputs {
         inputs.check_output("the output", p)?;

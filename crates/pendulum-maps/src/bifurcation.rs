@@ -8,8 +8,9 @@
 
 use std::path::Path;
 
-use pendulum_model::steady::steady_state_of;
-use pendulum_model::{ClassifyOptions, Dimensionless, Model, SimOptions, SteadyClass, SteadyState};
+use pendulum_model::{
+    ClassifyOptions, Dimensionless, MeanPowers, Model, SimOptions, SteadyClass, SteadyState,
+};
 use pendulum_plot::{CategoryScatter, Figure, Panel, Series, SeriesStyle};
 use pendulum_report::{Column, ColumnData, TableOptions, TableSummary};
 use rayon::prelude::*;
@@ -66,6 +67,9 @@ pub struct BifurcationConfig {
     pub classify: ClassifyOptions,
     /// Worker threads; `None` = rayon's global pool.
     pub threads: Option<usize>,
+    /// m g l ω0 of the rig, W: the mean powers' unit (dimensionless powers times it).
+    #[serde(default = "crate::power::default_scale_w")]
+    pub power_scale_w: f64,
 }
 
 impl BifurcationConfig {
@@ -81,6 +85,7 @@ impl BifurcationConfig {
             sim: SimOptions::with_tol(1e-8),
             classify: ClassifyOptions::default(),
             threads: None,
+            power_scale_w: crate::power::default_scale_w(),
         }
     }
 
@@ -157,6 +162,12 @@ impl BifurcationConfig {
                 self.record_periods
             )));
         }
+        if !(self.power_scale_w.is_finite() && self.power_scale_w > 0.0) {
+            return Err(MapsError::Invalid(format!(
+                "power scale {} W: expected m g l ω0 > 0",
+                self.power_scale_w
+            )));
+        }
         for i in 0..self.sweep.len() {
             let d = self.sweep.apply(&self.base, i);
             d.validate()?;
@@ -186,6 +197,8 @@ pub struct Outcome {
     /// Poincaré points, θ unwrapped (rad) and θ̇ (dimensionless), k = 0..=record.
     pub theta: Vec<f64>,
     pub theta_dot: Vec<f64>,
+    /// Mean powers over the recorded periods, W ([`crate::power`]).
+    pub power_w: MeanPowers,
 }
 
 /// A finished sweep.
@@ -205,14 +218,14 @@ fn simulate_one(
 ) -> Result<Outcome, MapsError> {
     let d = cfg.sweep.apply(&cfg.base, value_index);
     let model = Model::new(d);
-    let (steady, theta, theta_dot) = steady_state_of(
+    let (steady, theta, theta_dot, power_w) = crate::power::steady_with_power(
         &model,
         &cfg.sim,
         start,
-        0.0,
         cfg.transient_periods,
         cfg.record_periods,
         &cfg.classify,
+        cfg.power_scale_w,
     )?;
     Ok(Outcome {
         value_index,
@@ -223,6 +236,7 @@ fn simulate_one(
         steady,
         theta,
         theta_dot,
+        power_w,
     })
 }
 
@@ -410,6 +424,7 @@ pub fn merge_shards(
                 },
                 theta: th[r0..r1].to_vec(),
                 theta_dot: w[r0..r1].to_vec(),
+                power_w: crate::power::read_row(part, r0)?,
             });
             order.extend((r0..r1).map(|r| (*s, r)));
         }
@@ -504,6 +519,7 @@ impl Bifurcation {
         let mut class = Vec::with_capacity(n);
         let mut period = Vec::with_capacity(n);
         let mut speed = Vec::with_capacity(n);
+        let mut power = Vec::with_capacity(n);
         for o in &self.outcomes {
             let om = self
                 .config
@@ -523,6 +539,7 @@ impl Bifurcation {
                 class.push(o.steady.class.as_str().to_string());
                 period.push(i64::from(o.steady.period));
                 speed.push(o.steady.mean_theta_dot);
+                power.push(o.power_w);
             }
         }
         let mut cols = vec![Column::f64("omega", "1 (ω/ω0)", omega)
@@ -552,6 +569,8 @@ impl Bifurcation {
             Column::f64("mean_theta_dot", "1 (dθ/dt)", speed)
                 .describe("mean dimensionless rotation speed (0 for rest and oscillation)"),
         ]);
+        // Per start (repeated on each of its Poincaré rows, like its class).
+        cols.extend(crate::power::columns(&power, "per start: "));
         cols
     }
 
@@ -573,6 +592,7 @@ impl Bifurcation {
             ("transient_periods".into(), c.transient_periods.to_string()),
             ("record_periods".into(), c.record_periods.to_string()),
             ("tol".into(), c.sim.rtol.to_string()),
+            ("power_scale_w".into(), c.power_scale_w.to_string()),
             (
                 "params".into(),
                 serde_json::to_string(&c.base).unwrap_or_default(),

@@ -22,8 +22,10 @@
 //! the number of threads.
 
 pub mod bifurcation;
+pub mod design;
 pub mod ics;
 pub mod params_file;
+pub mod power;
 pub mod shard;
 pub mod style;
 pub mod sweep;

@@ -4,10 +4,10 @@
 //! * A map's **cells** are its independent units of work, numbered in the order the one-machine
 //!   table lists them: for `bifurcate` one (sweep value, start) simulation in grid mode and one
 //!   chain (start, up or down) in continuation mode; for `zones` one (x, y) cell with all its
-//!   starts and all models. Shard `i` of `n` takes the cells `c` with `c mod n = i`
-//!   (round-robin: neighbouring cells, which cost about the same, land on different shards, so
-//!   the shards finish together). Every map command (`bifurcate`, `zones`, and `design` when it
-//!   comes) shares this module.
+//!   starts and all models; for `design` one (Ω, r, load) with all its starts and models. Shard
+//!   `i` of `n` takes the cells `c` with `c mod n = i` (round-robin: neighbouring cells, which
+//!   cost about the same, land on different shards, so the shards finish together). Every map
+//!   command (`bifurcate`, `zones`, `design`) shares this module.
 //! * A shard writes `OUT/shard=i/part.parquet` — the rows of its cells, with exactly the columns
 //!   of the one-machine table, so DuckDB and polars read `OUT/shard=*/part.parquet` as one
 //!   Hive-partitioned table with a `shard` column — and then `OUT/shard=i/manifest.json`
@@ -201,7 +201,7 @@ impl ShardSpec {
 pub struct Manifest {
     /// [`FORMAT`].
     pub format: String,
-    /// The map command: `bifurcate` or `zones`.
+    /// The map command: `bifurcate`, `zones` or `design`.
     pub command: String,
     /// The pendulum version that computed the cells.
     pub version: String,

@@ -4,8 +4,7 @@
 
 use std::path::Path;
 
-use pendulum_model::steady::steady_state_of;
-use pendulum_model::{ClassifyOptions, Dimensionless, Model, SimOptions, SteadyClass};
+use pendulum_model::{ClassifyOptions, Dimensionless, MeanPowers, Model, SimOptions, SteadyClass};
 use pendulum_plot::{save_heatmaps_side_by_side, Heatmap};
 use pendulum_report::{Column, ColumnData, TableOptions, TableSummary};
 use rayon::prelude::*;
@@ -29,6 +28,10 @@ pub struct ZoneConfig {
     pub sim: SimOptions,
     pub classify: ClassifyOptions,
     pub threads: Option<usize>,
+    /// m g l ω0 of the rig, W: the mean powers' unit. One rig for every model of the map (the
+    /// first model's, when a job compares two), so that their watts compare.
+    #[serde(default = "crate::power::default_scale_w")]
+    pub power_scale_w: f64,
 }
 
 impl ZoneConfig {
@@ -43,6 +46,7 @@ impl ZoneConfig {
             sim: SimOptions::with_tol(1e-8),
             classify: ClassifyOptions::default(),
             threads: None,
+            power_scale_w: crate::power::default_scale_w(),
         }
     }
 
@@ -72,6 +76,12 @@ impl ZoneConfig {
         }
         if models.is_empty() {
             return Err(MapsError::Invalid("no models to map".into()));
+        }
+        if !(self.power_scale_w.is_finite() && self.power_scale_w > 0.0) {
+            return Err(MapsError::Invalid(format!(
+                "power scale {} W: expected m g l ω0 > 0",
+                self.power_scale_w
+            )));
         }
         for (name, base) in models {
             for ix in 0..self.x.len() {
@@ -123,6 +133,10 @@ pub struct ZoneCell {
     pub starts: usize,
     /// Mean |dθ/dt| (dimensionless) over the starts that rotate; NaN when none does.
     pub mean_rotation_speed: f64,
+    /// Mean powers over the starts (each over its recorded periods), W.
+    pub mean_power_w: MeanPowers,
+    /// Sample standard deviation over the starts of the power into the load, W.
+    pub load_power_sd_w: f64,
 }
 
 impl ZoneCell {
@@ -242,6 +256,123 @@ impl ZoneMap {
     }
 }
 
+impl ZoneMap {
+    /// A heat map of `f` over the grid (W), from 0 to its largest value.
+    fn power_heatmap(
+        &self,
+        title: &str,
+        value_label: &str,
+        f: impl Fn(&ZoneCell) -> f64,
+    ) -> Heatmap {
+        let values = self.grid(f);
+        let hi = values
+            .iter()
+            .flatten()
+            .copied()
+            .filter(|v| v.is_finite())
+            .fold(0.0f64, f64::max);
+        Heatmap {
+            title: title.to_string(),
+            values,
+            value_label: value_label.to_string(),
+            vmin: Some(0.0),
+            vmax: Some(if hi > 0.0 { hi } else { 1.0 }),
+            ..self.heatmap(String::new(), Vec::new())
+        }
+    }
+
+    /// Where the power goes on the map: the mean power into the generator's load and the mean
+    /// power the base's motion feeds in (which the losses dissipate), W, over the starts.
+    pub fn plot_power(&self, path: &Path) -> Result<(), MapsError> {
+        let load = self.power_heatmap(
+            "mean power into the generator's load",
+            "mean electrical power into the load over the starts (W)",
+            |c| c.mean_power_w.load,
+        );
+        let base = self.power_heatmap(
+            "mean power fed in by the base's motion",
+            "mean input power over the starts (W) = the losses' sum",
+            |c| c.mean_power_w.base,
+        );
+        save_heatmaps_side_by_side(
+            &[load, base],
+            &format!(
+                "Power, {}: {} starts per cell, classified over the last {} of {} + {} periods, powers over one orbit (rig m g l ω0 = {} W)",
+                self.describe(),
+                self.config.starts.len(),
+                self.config.record_periods,
+                self.config.transient_periods,
+                self.config.record_periods,
+                crate::style::fmt_num(self.config.power_scale_w)
+            ),
+            path,
+        )?;
+        Ok(())
+    }
+}
+
+/// Where two models disagree in power, W: the first's mean power into the load minus the
+/// second's, and the same for the input power, each on a range symmetric about 0 (the middle of
+/// the colour bar is agreement). Returns the largest |difference| of each (W).
+pub fn plot_power_comparison(
+    a: &ZoneMap,
+    b: &ZoneMap,
+    path: &Path,
+) -> Result<(f64, f64), MapsError> {
+    compare(a, b)?;
+    let diff = |f: fn(&ZoneCell) -> f64| -> Vec<Vec<f64>> {
+        (0..a.config.y.len())
+            .map(|iy| {
+                (0..a.config.x.len())
+                    .map(|ix| f(a.cell(ix, iy)) - f(b.cell(ix, iy)))
+                    .collect()
+            })
+            .collect()
+    };
+    let span = |v: &[Vec<f64>]| {
+        v.iter()
+            .flatten()
+            .copied()
+            .filter(|x| x.is_finite())
+            .fold(0.0f64, |m, x| m.max(x.abs()))
+    };
+    let load = diff(|c| c.mean_power_w.load);
+    let base = diff(|c| c.mean_power_w.base);
+    let (sl, sb) = (span(&load), span(&base));
+    let map = |title: String, values: Vec<Vec<f64>>, s: f64| Heatmap {
+        title,
+        values,
+        value_label: format!("{} − {} (W)", a.label, b.label),
+        vmin: Some(-if s > 0.0 { s } else { 1.0 }),
+        vmax: Some(if s > 0.0 { s } else { 1.0 }),
+        ..a.heatmap(String::new(), Vec::new())
+    };
+    save_heatmaps_side_by_side(
+        &[
+            map(
+                format!("power into the load, {} minus {}", a.label, b.label),
+                load,
+                sl,
+            ),
+            map(
+                format!("input power, {} minus {}", a.label, b.label),
+                base,
+                sb,
+            ),
+        ],
+        &format!(
+            "Where {} and {} disagree in power (W; mean over {} starts per cell): largest gap {} W into the load, {} W input",
+            a.label,
+            b.label,
+            a.config.starts.len(),
+            crate::style::fmt_num(sl),
+            crate::style::fmt_num(sb)
+        ),
+        path,
+    )?;
+    Ok((sl, sb))
+}
+
 /// Runs every model on the same grid and starts, in parallel over (model, cell, start).
 /// `progress` is called with 1 per finished simulation.
 pub fn run(
@@ -281,16 +412,16 @@ pub fn run_cells(
             .par_iter()
             .map(|&(m, ix, iy, s)| {
                 let d = cfg.cell_params(&models[m].1, ix, iy);
-                let r = steady_state_of(
+                let r = crate::power::steady_with_power(
                     &Model::new(d),
                     &cfg.sim,
                     cfg.starts[s],
-                    0.0,
                     cfg.transient_periods,
                     cfg.record_periods,
                     &cfg.classify,
+                    cfg.power_scale_w,
                 )
-                .map(|(st, _, _)| st);
+                .map(|(st, _, _, pw)| (st, pw));
                 progress(1);
                 r
             })
@@ -304,7 +435,9 @@ pub fn run_cells(
             let (ix, iy) = (c % nx, c / nx);
             let mut counts = [0usize; 5];
             let (mut speed_sum, mut n_rot) = (0.0, 0usize);
-            for st in it.by_ref().take(ns) {
+            let mut powers = Vec::with_capacity(ns);
+            for (st, pw) in it.by_ref().take(ns) {
+                powers.push(pw);
                 counts[class_index(st.class)] += 1;
                 if st.class.is_rotation() {
                     speed_sum += st.mean_theta_dot.abs();
@@ -323,6 +456,10 @@ pub fn run_cells(
                 } else {
                     f64::NAN
                 },
+                mean_power_w: crate::power::mean_of(&powers),
+                load_power_sd_w: crate::power::sample_sd(
+                    &powers.iter().map(|p| p.load).collect::<Vec<_>>(),
+                ),
             });
         }
         maps.push(ZoneMap {
@@ -420,6 +557,8 @@ pub fn columns(maps: &[ZoneMap]) -> Result<Vec<Column>, MapsError> {
     let mut frac = Vec::new();
     let mut per_class: [Vec<f64>; 5] = Default::default();
     let mut speed = Vec::new();
+    let mut power = Vec::new();
+    let mut load_sd = Vec::new();
     let mut dis = Vec::new();
     for m in maps {
         if m.config.x.param != xp || m.config.y.param != yp {
@@ -438,6 +577,8 @@ pub fn columns(maps: &[ZoneMap]) -> Result<Vec<Column>, MapsError> {
                 per_class[k].push(c.fraction(*cl));
             }
             speed.push(c.mean_rotation_speed);
+            power.push(c.mean_power_w);
+            load_sd.push(c.load_power_sd_w);
             if let Some(d) = &disagree {
                 dis.push(d.binary_search(&(c.ix, c.iy)).is_ok());
             }
@@ -464,6 +605,14 @@ pub fn columns(maps: &[ZoneMap]) -> Result<Vec<Column>, MapsError> {
     cols.push(
         Column::f64("mean_rotation_speed", "1 (dθ/dt)", speed)
             .describe("mean |dθ/dt| of the rotating starts, dimensionless; NaN if none"),
+    );
+    cols.extend(crate::power::columns(
+        &power,
+        "mean over the cell's starts of the ",
+    ));
+    cols.push(
+        Column::f64("load_power_sd_w", "W", load_sd)
+            .describe("standard deviation over the cell's starts of the mean power into the load, W (its standard error: divide by √starts)"),
     );
     if disagree.is_some() {
         cols.push(
@@ -493,6 +642,7 @@ pub fn metadata(
         ),
         ("record_periods".to_string(), c.record_periods.to_string()),
         ("tol".to_string(), c.sim.rtol.to_string()),
+        ("power_scale_w".to_string(), c.power_scale_w.to_string()),
     ];
     for m in maps {
         md.push((
@@ -586,6 +736,15 @@ pub fn merge_shards(
                 counts,
                 starts: ns,
                 mean_rotation_speed: speed[r],
+                mean_power_w: crate::power::read_row(part, r)?,
+                load_power_sd_w: match col(part, "load_power_sd_w")? {
+                    ColumnData::F64(v) => v[r],
+                    _ => {
+                        return Err(MapsError::Invalid(
+                            "column load_power_sd_w is not f64".into(),
+                        ))
+                    }
+                },
             };
             let same = SteadyClass::ALL.iter().all(|cl| {
                 matches!(col(part, &format!("{}_fraction", cl.as_str())),
