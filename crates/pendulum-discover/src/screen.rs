@@ -412,38 +412,20 @@ pub fn profile_shape_band(
         let (v, se) = fit.coef_of(col)?;
         return Some((sh.shape.default, fit, (v - 1.96 * se, v + 1.96 * se)));
     };
-    let (mut lo, mut hi) = (
-        grid[ib.saturating_sub(1)].ln(),
-        grid[(ib + 1).min(grid.len() - 1)].ln(),
-    );
-    let g = 0.5 * (5f64.sqrt() - 1.0);
-    let mut cost = |u: f64| {
+    let cost = |u: f64| {
         at(u.exp())
             .filter(|f| possible(f))
             .map_or(f64::INFINITY, |f| f.rss)
     };
-    let (mut a, mut b) = (hi - g * (hi - lo), lo + g * (hi - lo));
-    let (mut fa, mut fb) = (cost(a), cost(b));
-    for _ in 0..24 {
-        if fa < fb {
-            hi = b;
-            b = a;
-            fb = fa;
-            a = hi - g * (hi - lo);
-            fa = cost(a);
-        } else {
-            lo = a;
-            a = b;
-            fa = fb;
-            b = lo + g * (hi - lo);
-            fb = cost(b);
-        }
-    }
+    let gs = pendulum_numerics::golden_section(
+        cost,
+        grid[ib.saturating_sub(1)].ln(),
+        grid[(ib + 1).min(grid.len() - 1)].ln(),
+        24,
+    );
     let mut best = (grid[ib], rss[ib]);
-    for (u, f) in [(a, fa), (b, fb)] {
-        if f < best.1 {
-            best = (u.exp(), f);
-        }
+    if gs.f < best.1 {
+        best = (gs.x.exp(), gs.f);
     }
     let fit = at(best.0)?;
     let size = |f: &Ols| f.coef_of(col).map(|(v, se)| (v - 1.96 * se, v + 1.96 * se));

@@ -523,8 +523,8 @@ pub fn weak_rows(run_idx: usize, run: &RunData, al: &Alignment, cfg: &WeakConfig
 #[cfg(test)]
 mod tests {
     use super::*;
-    use pendulum_model::{simulate, Dimensionless, Excitation, Model, SimOptions};
-    use pendulum_process::{RigParams, Role};
+    use pendulum_model::Dimensionless;
+    use pendulum_process::RigParams;
 
     /// On an exact free decay with viscous + bearing friction, the weak-form regression returns
     /// β and M (an independent check of the integration by parts and the scalings).
@@ -543,44 +543,7 @@ mod tests {
         let mut d = Dimensionless::conservative();
         d.beta = 0.05;
         d.m_coulomb = 0.007;
-        let m = Model::with_excitation(d, Excitation::None);
-        let dt = 0.001 * w0;
-        let tr = simulate(
-            &m,
-            &SimOptions::with_tol(1e-10),
-            [2.0, 0.0],
-            0.0,
-            20.0 * w0,
-            dt,
-        )
-        .unwrap();
-        let run = RunData {
-            id: "x".into(),
-            role: Role::Identify,
-            rig: rig.clone(),
-            enc_t_s: tr.t.iter().map(|t| t / w0).collect(),
-            theta_rad: tr.theta.clone(),
-            acc_t_s: vec![],
-            az_m_s2: vec![],
-            ax_m_s2: vec![],
-        };
-        let al = Alignment {
-            kind: pendulum_process::align::AlignmentKind::Shaker,
-            omega0_est_rad_s: f64::NAN,
-            shaker_start_s: 30.0,
-            free_segment_s: (0.0, 19.9),
-            t0_s: 25.0,
-            t0_sigma_s: 0.0,
-            omega_hz: 1.5,
-            omega_sigma_hz: 0.0,
-            accel_gain: 1.0,
-            az_offset_m_s2: 9.81,
-            residual_rms_m_s2: 0.0,
-            fit_window_s: (0.0, 0.0),
-            speed_drift_hz_per_s: 0.0,
-            accel_noise_m_s2: f64::NAN,
-            forcing_residual_rms_m_s2: f64::NAN,
-        };
+        let (run, al) = super::shaped_tests::decay(&rig, d, 2.0, 20.0);
         // The old default half-width and the current one.
         for hw in [0.08, 0.16] {
             let cfg = WeakConfig {
@@ -615,12 +578,18 @@ mod shaped_tests {
     use pendulum_model::{simulate, Dimensionless, Excitation, Model, SimOptions};
     use pendulum_process::{RigParams, Role};
 
-    /// A free decay of an exact model (1 kHz, no noise) as a run with its alignment.
-    fn decay(rig: &RigParams, d: Dimensionless, theta0: f64, dur_s: f64) -> (RunData, Alignment) {
+    /// A free decay of an exact model (1 kHz, no noise) as a run with its alignment (the shaker
+    /// starts 10 s after it).
+    pub(super) fn decay(
+        rig: &RigParams,
+        d: Dimensionless,
+        theta0: f64,
+        dur_s: f64,
+    ) -> (RunData, Alignment) {
         let w0 = rig.omega0_rad_s();
         let tr = simulate(
             &Model::with_excitation(d, Excitation::None),
-            &SimOptions::with_tol(1e-11),
+            &SimOptions::with_tol(1e-10),
             [theta0, 0.0],
             0.0,
             dur_s * w0,

@@ -1105,26 +1105,8 @@ fn period_law(tps: &[TurningPoint], step_rad: f64, z: f64) -> Option<PeriodLaw> 
     };
     let rss = |u: f64| resid(u).0.iter().map(|v| v * v).sum::<f64>();
     // Golden section on u ∈ [0, 1] (the misfit is smooth in u).
-    let (mut lo, mut hi) = (0.0f64, 1.0f64);
-    let g = 0.5 * (5f64.sqrt() - 1.0);
-    let (mut x1, mut x2) = (hi - g * (hi - lo), lo + g * (hi - lo));
-    let (mut f1, mut f2) = (rss(x1), rss(x2));
-    for _ in 0..60 {
-        if f1 < f2 {
-            hi = x2;
-            x2 = x1;
-            f2 = f1;
-            x1 = hi - g * (hi - lo);
-            f1 = rss(x1);
-        } else {
-            lo = x1;
-            x1 = x2;
-            f1 = f2;
-            x2 = lo + g * (hi - lo);
-            f2 = rss(x2);
-        }
-    }
-    let mut u = 0.5 * (lo + hi);
+    let gs = pendulum_numerics::golden_section(rss, 0.0, 1.0, 60);
+    let mut u = 0.5 * (gs.lo + gs.hi);
     for end in [0.0, 1.0] {
         if rss(end) <= rss(u) {
             u = end;
