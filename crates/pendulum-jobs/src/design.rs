@@ -58,7 +58,8 @@ pub struct DesignArgs {
         default_value = "0.0725,0.1065,0.205"
     )]
     pub crank_r_m: String,
-    /// Generator loads c_g = k_e²/R to search, N·m·s/rad (default 0.01,0.02,0.04,0.08,0.16,0.32).
+    /// Generator loads c_g = k_e²/R to search, N·m·s/rad (default 0.01 to 2.56, doubling: wide
+    /// enough that a load too heavy to keep the pendulum rotating is in the search).
     #[arg(long = "c-g", value_name = "LIST", allow_hyphen_values = true)]
     pub c_g: Option<String>,
     /// Generator dead bands ω_d = V_d/k_e to search, rad/s (default 0,2); every pair with --c-g.
@@ -238,7 +239,9 @@ fn loads_of(a: &DesignArgs) -> Result<Vec<Load>, JobError> {
     }
     let c = parse_list(
         "--c-g",
-        a.c_g.as_deref().unwrap_or("0.01,0.02,0.04,0.08,0.16,0.32"),
+        a.c_g
+            .as_deref()
+            .unwrap_or("0.01,0.02,0.04,0.08,0.16,0.32,0.64,1.28,2.56"),
     )?;
     let w = parse_list("--omega-d", a.omega_d.as_deref().unwrap_or("0,2"))?;
     Ok(c.iter()

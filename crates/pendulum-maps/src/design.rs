@@ -796,26 +796,53 @@ pub fn fmt_w(v: f64) -> String {
     }
 }
 
-/// Where `b` lies on an edge of the searched grid, in words (an optimum there may lie beyond).
+/// The rig's largest crank speed set point and crank radius (rig.md's tables): an optimum there
+/// is at what the rig can do, not at the edge of a search that could be widened.
+pub const RIG_MAX_OMEGA_HZ: f64 = 2.36;
+pub const RIG_MAX_CRANK_R_M: f64 = 0.205;
+
+/// Where `b` lies on an edge of the searched grid, in words (an optimum there may lie beyond),
+/// and, apart, where it lies at the rig's own limits (rig.md's largest Ω and r).
 pub fn edges_of(cfg: &DesignConfig, b: &DesignCell) -> Vec<String> {
-    let mut out = Vec::new();
-    let mut edge = |name: &str, v: f64, all: Vec<f64>| {
+    edges_and_limits(cfg, b).0
+}
+
+/// ([`edges_of`], the rig's limits the optimum sits at).
+pub fn edges_and_limits(cfg: &DesignConfig, b: &DesignCell) -> (Vec<String>, Vec<String>) {
+    let (mut out, mut limits) = (Vec::new(), Vec::new());
+    let mut edge = |name: &str, v: f64, all: Vec<f64>, rig_max: Option<(f64, &str)>| {
         let lo = all.iter().copied().fold(f64::INFINITY, f64::min);
         let hi = all.iter().copied().fold(f64::NEG_INFINITY, f64::max);
         if lo < hi && v == hi {
-            out.push(format!("the largest {name} searched"));
+            match rig_max {
+                Some((m, unit)) if (v - m).abs() <= 1e-9 * m => {
+                    limits.push(format!("the rig's largest {name} ({} {unit})", fmt_num(m)));
+                }
+                _ => out.push(format!("the largest {name} searched")),
+            }
         } else if lo < hi && v == lo {
             out.push(format!("the smallest {name} searched"));
         }
     };
-    edge("Ω", b.omega_hz, cfg.omega_hz.clone());
-    edge("r", b.crank_r_m, cfg.crank_r_m.clone());
+    edge(
+        "Ω",
+        b.omega_hz,
+        cfg.omega_hz.clone(),
+        Some((RIG_MAX_OMEGA_HZ, "Hz")),
+    );
+    edge(
+        "r",
+        b.crank_r_m,
+        cfg.crank_r_m.clone(),
+        Some((RIG_MAX_CRANK_R_M, "m")),
+    );
     edge(
         "c_g",
         b.load.c_g_nm_s_rad,
         cfg.loads.iter().map(|l| l.c_g_nm_s_rad).collect(),
+        None,
     );
-    out
+    (out, limits)
 }
 
 /// `design.md`: the answer in words (this load, this speed, this many watts, this sure), each
@@ -875,6 +902,13 @@ pub fn summary_markdown(designs: &[Design]) -> String {
             s.push_str(&format!(
                 "The optimum is at {}: the best may lie beyond the grid; widen the search there.\n\n",
                 edges.join(" and ")
+            ));
+        }
+        let (_, limits) = edges_and_limits(cfg, b);
+        if !limits.is_empty() {
+            s.push_str(&format!(
+                "The optimum is at {}: as hard as this rig can shake (rig.md's set points), not an edge of the search.\n\n",
+                limits.join(" and ")
             ));
         }
         for other in designs.iter().filter(|o| o.model.label != d.model.label) {
