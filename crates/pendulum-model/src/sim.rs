@@ -137,13 +137,22 @@ impl Model {
         } else {
             0.0
         };
-        self.accel_in(t, theta, theta_dot, dir, gen)
+        self.accel_in::<true, true>(t, theta, theta_dot, dir, gen)
     }
 
     /// θ̈ with the generator held in mode `gen` ([`Model::gen_mode`]): the integrator's smooth
-    /// right-hand side within a step.
+    /// right-hand side within a step. `STRIBECK` / `GEN` false compile the breakaway / generator
+    /// term out (chosen once per integration from the coefficients, see [`integrate`]); true keeps
+    /// the run-time test of the coefficient, so `<true, true>` is right for every model.
     #[inline(always)]
-    fn accel_in(&self, t: f64, theta: f64, theta_dot: f64, dir: f64, gen: f64) -> f64 {
+    fn accel_in<const STRIBECK: bool, const GEN: bool>(
+        &self,
+        t: f64,
+        theta: f64,
+        theta_dot: f64,
+        dir: f64,
+        gen: f64,
+    ) -> f64 {
         let p = &self.params;
         let (ay, ax) = self.base_accel(t);
         let (s, c) = sin_cos(theta);
@@ -158,14 +167,14 @@ impl Model {
             };
             let mut dry = p.m_coulomb * load + p.c;
             // Tested, not multiplied by zero: the exp is the costliest term, and most models lack it.
-            if p.s_break != 0.0 {
+            if STRIBECK && p.s_break != 0.0 {
                 let x = theta_dot / p.v_break;
                 dry += p.s_break * (-x * x).exp();
             }
             q -= dry * dir;
         }
         // Tested first: most models have no generator, and those that do spend time in its band.
-        if p.gen_c != 0.0 && gen != 0.0 {
+        if GEN && p.gen_c != 0.0 && gen != 0.0 {
             q -= p.gen_c * (theta_dot - gen * p.gen_w);
         }
         if p.p != 0.0 {
@@ -487,6 +496,39 @@ pub fn integrate<I, F>(
     y0: [f64; 2],
     t_end: f64,
     times: I,
+    sink: F,
+) -> Result<SimStats, ModelError>
+where
+    I: IntoIterator<Item = f64>,
+    F: FnMut(Sample) -> ControlFlow<()>,
+{
+    // The optional terms are chosen once here, not tested in every right-hand side and step:
+    // a model without them runs the step loop it had before they existed (issue 14: "the
+    // simulator bench must not slow down"). Each variant computes the same numbers as the
+    // general one, since a term compiled out is one whose coefficient is zero.
+    let p = &model.params;
+    match (p.s_break != 0.0, p.gen_c != 0.0) {
+        (false, false) => {
+            integrate_with::<false, false, I, F>(model, opts, t0, y0, t_end, times, sink)
+        }
+        (true, false) => {
+            integrate_with::<true, false, I, F>(model, opts, t0, y0, t_end, times, sink)
+        }
+        (false, true) => {
+            integrate_with::<false, true, I, F>(model, opts, t0, y0, t_end, times, sink)
+        }
+        (true, true) => integrate_with::<true, true, I, F>(model, opts, t0, y0, t_end, times, sink),
+    }
+}
+
+/// [`integrate`] with the breakaway (`STRIBECK`) and generator (`GEN`) terms compiled in or out.
+fn integrate_with<const STRIBECK: bool, const GEN: bool, I, F>(
+    model: &Model,
+    opts: &SimOptions,
+    t0: f64,
+    y0: [f64; 2],
+    t_end: f64,
+    times: I,
     mut sink: F,
 ) -> Result<SimStats, ModelError>
 where
@@ -546,8 +588,8 @@ where
         dir = 0.0;
     }
     // The generator's mode (see the module docs); it switches only where its dead band has an
-    // edge (w > 0).
-    let gen_switch = model.params.gen_c != 0.0 && model.params.gen_w > 0.0;
+    // edge (w > 0). GEN is true exactly when g ≠ 0.
+    let gen_switch = GEN && model.params.gen_w > 0.0;
     let mut gen = model.gen_mode(y[1]);
     // Events that made no progress in a row (a guard against Zeno behaviour).
     let mut idle_events = 0u32;
@@ -606,7 +648,7 @@ where
             });
         }
         if need_k1 {
-            k1 = f(model, t, y, dir, gen);
+            k1 = f::<STRIBECK, GEN>(model, t, y, dir, gen);
             stats.rhs_evals += 1;
             need_k1 = false;
         }
@@ -615,22 +657,22 @@ where
             h = t_end - t;
         }
         // One DOPRI5 step.
-        let k2 = f(model, t + dp::C2 * h, add(y, h, &[(dp::A21, k1)]), dir, gen);
-        let k3 = f(
+        let k2 = f::<STRIBECK, GEN>(model, t + dp::C2 * h, add(y, h, &[(dp::A21, k1)]), dir, gen);
+        let k3 = f::<STRIBECK, GEN>(
             model,
             t + dp::C3 * h,
             add(y, h, &[(dp::A31, k1), (dp::A32, k2)]),
             dir,
             gen,
         );
-        let k4 = f(
+        let k4 = f::<STRIBECK, GEN>(
             model,
             t + dp::C4 * h,
             add(y, h, &[(dp::A41, k1), (dp::A42, k2), (dp::A43, k3)]),
             dir,
             gen,
         );
-        let k5 = f(
+        let k5 = f::<STRIBECK, GEN>(
             model,
             t + dp::C5 * h,
             add(
@@ -652,7 +694,7 @@ where
                 (dp::A65, k5),
             ],
         );
-        let k6 = f(model, t + h, y6, dir, gen);
+        let k6 = f::<STRIBECK, GEN>(model, t + h, y6, dir, gen);
         let y_new = add(
             y,
             h,
@@ -664,7 +706,7 @@ where
                 (dp::A76, k6),
             ],
         );
-        let k7 = f(model, t + h, y_new, dir, gen);
+        let k7 = f::<STRIBECK, GEN>(model, t + h, y_new, dir, gen);
         stats.rhs_evals += 6;
         let mut err = 0.0;
         for i in 0..2 {
@@ -798,7 +840,7 @@ where
                 yb[1] = side * w;
                 // On the edge both modes give the same θ̈ (the torque is continuous): its sign
                 // says which side the motion goes on to.
-                let a = model.accel_in(tb, yb[0], yb[1], dir, 0.0);
+                let a = model.accel_in::<STRIBECK, GEN>(tb, yb[0], yb[1], dir, 0.0);
                 gen = if a * side > 0.0 { side } else { 0.0 };
                 t = tb;
                 y = yb;
@@ -875,8 +917,11 @@ where
 }
 
 #[inline]
-fn f(model: &Model, t: f64, y: Y, dir: f64, gen: f64) -> Y {
-    [y[1], model.accel_in(t, y[0], y[1], dir, gen)]
+fn f<const STRIBECK: bool, const GEN: bool>(model: &Model, t: f64, y: Y, dir: f64, gen: f64) -> Y {
+    [
+        y[1],
+        model.accel_in::<STRIBECK, GEN>(t, y[0], y[1], dir, gen),
+    ]
 }
 
 #[inline]
