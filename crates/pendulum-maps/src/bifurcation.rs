@@ -150,18 +150,7 @@ impl BifurcationConfig {
         if self.sweep.is_empty() {
             return Err(MapsError::Invalid("the sweep has no values".into()));
         }
-        if self.starts.is_empty() {
-            return Err(MapsError::Invalid("no initial states".into()));
-        }
-        if self.starts.iter().flatten().any(|v| !v.is_finite()) {
-            return Err(MapsError::Invalid("initial states must be finite".into()));
-        }
-        if self.record_periods < 2 {
-            return Err(MapsError::Invalid(format!(
-                "record {} periods: at least 2 are needed to classify (32 to find period 16)",
-                self.record_periods
-            )));
-        }
+        crate::ics::check_starts(&self.starts, self.record_periods)?;
         if !(self.power_scale_w.is_finite() && self.power_scale_w > 0.0) {
             return Err(MapsError::Invalid(format!(
                 "power scale {} W: expected m g l ω0 > 0",
@@ -327,13 +316,7 @@ pub fn merge_shards(
 ) -> Result<(Bifurcation, Vec<Column>), MapsError> {
     use crate::shard::col;
     cfg.validate()?;
-    if set.first().cells_total != cfg.cells() {
-        return Err(MapsError::Invalid(format!(
-            "the shards deal {} cells, the sweep has {}",
-            set.first().cells_total,
-            cfg.cells()
-        )));
-    }
+    set.check_cells(cfg.cells(), "the sweep")?;
     // Each part's rows split into outcomes (a new one starts at k = 0), grouped by cell.
     // Per cell: the shard holding it and its simulations' row ranges in that shard's table.
     type CellRows = Option<(usize, Vec<(usize, usize)>)>;

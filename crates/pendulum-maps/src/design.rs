@@ -213,18 +213,7 @@ impl DesignConfig {
             list("c_g", &[l.c_g_nm_s_rad], "N·m·s/rad", false)?;
             list("omega_d", &[l.omega_d_rad_s], "rad/s", false)?;
         }
-        if self.starts.is_empty() {
-            return Err(MapsError::Invalid("no initial states".into()));
-        }
-        if self.starts.iter().flatten().any(|v| !v.is_finite()) {
-            return Err(MapsError::Invalid("initial states must be finite".into()));
-        }
-        if self.record_periods < 2 {
-            return Err(MapsError::Invalid(format!(
-                "record {} periods: at least 2 are needed to classify",
-                self.record_periods
-            )));
-        }
+        crate::ics::check_starts(&self.starts, self.record_periods)?;
         if models.is_empty() {
             return Err(MapsError::Invalid("no models to design for".into()));
         }
@@ -533,12 +522,7 @@ pub fn merge_shards(
     use crate::shard::col;
     cfg.validate(models)?;
     let total = cfg.cells();
-    if set.first().cells_total != total {
-        return Err(MapsError::Invalid(format!(
-            "the shards deal {} cells, the search has {total}",
-            set.first().cells_total
-        )));
-    }
+    set.check_cells(total, "the search")?;
     let owner = set.cell_owner();
     let ns = cfg.starts.len();
     let mut designs = Vec::with_capacity(models.len());

@@ -184,6 +184,23 @@ impl IcSpec {
     }
 }
 
+/// The checks every map's starts and recording share: at least one start, all finite, and
+/// at least 2 recorded periods (what the classifier needs; 32 find a period of 16).
+pub fn check_starts(starts: &[[f64; 2]], record_periods: u32) -> Result<(), MapsError> {
+    if starts.is_empty() {
+        return Err(MapsError::Invalid("no initial states".into()));
+    }
+    if starts.iter().flatten().any(|v| !v.is_finite()) {
+        return Err(MapsError::Invalid("initial states must be finite".into()));
+    }
+    if record_periods < 2 {
+        return Err(MapsError::Invalid(format!(
+            "record {record_periods} periods: at least 2 are needed to classify (32 to find period 16)"
+        )));
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -398,6 +398,18 @@ impl ShardSet {
         &self.manifests[0]
     }
 
+    /// That the shards deal `total` cells, the number the run being merged has (`what`: "the
+    /// map", "the sweep", "the search").
+    pub fn check_cells(&self, total: usize, what: &str) -> Result<(), MapsError> {
+        let dealt = self.first().cells_total;
+        if dealt != total {
+            return Err(MapsError::Invalid(format!(
+                "the shards deal {dealt} cells, {what} has {total}"
+            )));
+        }
+        Ok(())
+    }
+
     /// For each cell of the map, the shard holding it and its position among that shard's cells.
     pub fn cell_owner(&self) -> Vec<(usize, usize)> {
         let mut owner = vec![(usize::MAX, 0); self.first().cells_total];

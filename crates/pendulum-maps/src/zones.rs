@@ -65,15 +65,7 @@ impl ZoneConfig {
         if self.x.is_empty() || self.y.is_empty() {
             return Err(MapsError::Invalid("a sweep has no values".into()));
         }
-        if self.starts.is_empty() {
-            return Err(MapsError::Invalid("no initial states".into()));
-        }
-        if self.record_periods < 2 {
-            return Err(MapsError::Invalid(format!(
-                "record {} periods: at least 2 are needed to classify",
-                self.record_periods
-            )));
-        }
+        crate::ics::check_starts(&self.starts, self.record_periods)?;
         if models.is_empty() {
             return Err(MapsError::Invalid("no models to map".into()));
         }
@@ -680,12 +672,7 @@ pub fn merge_shards(
     use crate::shard::col;
     cfg.validate(models)?;
     let total = cfg.cells();
-    if set.first().cells_total != total {
-        return Err(MapsError::Invalid(format!(
-            "the shards deal {} cells, the map has {total}",
-            set.first().cells_total
-        )));
-    }
+    set.check_cells(total, "the map")?;
     let owner = set.cell_owner();
     let (nx, ns) = (cfg.x.len(), cfg.starts.len());
     let mut order = Vec::with_capacity(models.len() * total);
