@@ -754,6 +754,7 @@ pub fn plot_map(designs: &[Design], path: &Path) -> Result<(), MapsError> {
                 vmin: Some(0.0),
                 vmax: Some(if hi > 0.0 { hi } else { 1.0 }),
                 marks,
+                diverging: false,
                 width: 800,
                 height: 650,
             }

@@ -195,6 +195,7 @@ impl ZoneMap {
             vmin: Some(0.0),
             vmax: Some(100.0),
             marks,
+            diverging: false,
             width: 900,
             height: 700,
         }
@@ -337,29 +338,49 @@ pub fn plot_power_comparison(
         value_label: format!("{} − {} (W)", a.label, b.label),
         vmin: Some(-if s > 0.0 { s } else { 1.0 }),
         vmax: Some(if s > 0.0 { s } else { 1.0 }),
+        diverging: true,
         ..a.heatmap(String::new(), Vec::new())
     };
-    save_heatmaps_side_by_side(
-        &[
+    let input = map(
+        format!("input power, {} minus {}", a.label, b.label),
+        base,
+        sb,
+    );
+    // Without a generator in either model the load panel is 0 everywhere: say so and draw the
+    // input power alone.
+    let no_load = load.iter().flatten().all(|v| *v == 0.0);
+    let panels = if no_load {
+        vec![input]
+    } else {
+        vec![
             map(
                 format!("power into the load, {} minus {}", a.label, b.label),
                 load,
                 sl,
             ),
-            map(
-                format!("input power, {} minus {}", a.label, b.label),
-                base,
-                sb,
-            ),
-        ],
-        &format!(
-            "Where {} and {} disagree in power (W; mean over {} starts per cell): largest gap {} W into the load, {} W input",
-            a.label,
-            b.label,
-            a.config.starts.len(),
-            crate::style::fmt_num(sl),
-            crate::style::fmt_num(sb)
-        ),
+            input,
+        ]
+    };
+    save_heatmaps_side_by_side(
+        &panels,
+        &if no_load {
+            format!(
+                "Where {} and {} disagree in input power (W; mean over {} starts per cell; no generator load in either model): largest gap {} W",
+                a.label,
+                b.label,
+                a.config.starts.len(),
+                crate::style::fmt_num(sb)
+            )
+        } else {
+            format!(
+                "Where {} and {} disagree in power (W; mean over {} starts per cell): largest gap {} W into the load, {} W input",
+                a.label,
+                b.label,
+                a.config.starts.len(),
+                crate::style::fmt_num(sl),
+                crate::style::fmt_num(sb)
+            )
+        },
         path,
     )?;
     Ok((sl, sb))

@@ -197,6 +197,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         marks: marks.clone(),
         width: 1000,
         height: 700,
+        diverging: false,
     };
     let hm_b = Heatmap {
         title: "Rotation zone, flexible model".into(),

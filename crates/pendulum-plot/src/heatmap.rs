@@ -46,6 +46,38 @@ fn viridis(t: f64) -> RGBColor {
     RGBColor(mix(a.0, b.0), mix(a.1, b.1), mix(a.2, b.2))
 }
 
+/// Blue–white–red of `t` in 0..=1 (clamped), white at 0.5: ColorBrewer's RdBu ends
+/// (colour-blind safe), for signed differences.
+fn diverging(t: f64) -> RGBColor {
+    const STOPS: [(u8, u8, u8); 5] = [
+        (33, 102, 172),
+        (146, 197, 222),
+        (247, 247, 247),
+        (244, 165, 130),
+        (178, 24, 43),
+    ];
+    let t = if t.is_finite() {
+        t.clamp(0.0, 1.0)
+    } else {
+        0.5
+    };
+    let f = t * (STOPS.len() - 1) as f64;
+    let i = (f.floor() as usize).min(STOPS.len() - 2);
+    let u = f - i as f64;
+    let (a, b) = (STOPS[i], STOPS[i + 1]);
+    let mix = |p: u8, q: u8| (f64::from(p) + u * (f64::from(q) - f64::from(p))).round() as u8;
+    RGBColor(mix(a.0, b.0), mix(a.1, b.1), mix(a.2, b.2))
+}
+
+/// The heat map's colour of `t` in 0..=1.
+fn scale(hm: &Heatmap, t: f64) -> RGBColor {
+    if hm.diverging {
+        diverging(t)
+    } else {
+        viridis(t)
+    }
+}
+
 pub fn save(hm: &Heatmap, path: &Path) -> Result<(), PlotError> {
     common::check_size(path, hm.width, hm.height)?;
     validate(hm, path)?;
@@ -237,7 +269,7 @@ fn draw_map(area: &Area<'_>, hm: &Heatmap, s: f64, subtitle: Option<&str>) -> Re
         chart
             .draw_series(cells.map(|(ix, iy, v)| {
                 let color = if v.is_finite() {
-                    viridis((v - vlo) / (vhi - vlo))
+                    scale(hm, (v - vlo) / (vhi - vlo))
                 } else {
                     common::NO_DATA
                 };
@@ -328,7 +360,7 @@ fn draw_map(area: &Area<'_>, hm: &Heatmap, s: f64, subtitle: Option<&str>) -> Re
         let b = vlo + (vhi - vlo) * (k + 1) as f64 / steps as f64;
         Rectangle::new(
             [(0.0, a), (1.0, b)],
-            viridis((k as f64 + 0.5) / steps as f64).filled(),
+            scale(hm, (k as f64 + 0.5) / steps as f64).filled(),
         )
     }))
     .map_err(|e| e.to_string())?;
@@ -365,4 +397,30 @@ fn draw_map(area: &Area<'_>, hm: &Heatmap, s: f64, subtitle: Option<&str>) -> Re
             .map_err(|e| e.to_string())?;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The diverging scale is white at its middle (0 difference), RdBu's blue and red at its
+    /// ends, and lighter towards the middle on both sides, so equal and opposite differences
+    /// read as equally strong.
+    #[test]
+    fn diverging_scale_is_white_in_the_middle_and_symmetric_in_lightness() {
+        assert_eq!(diverging(0.5), RGBColor(247, 247, 247));
+        assert_eq!(diverging(0.0), RGBColor(33, 102, 172));
+        assert_eq!(diverging(1.0), RGBColor(178, 24, 43));
+        let light = |c: RGBColor| u32::from(c.0) + u32::from(c.1) + u32::from(c.2);
+        for k in 0..10 {
+            let t = 0.05 * f64::from(k);
+            assert!(light(diverging(t)) <= light(diverging(t + 0.05)), "{t}");
+            assert!(
+                light(diverging(1.0 - t)) <= light(diverging(0.95 - t)),
+                "{t}"
+            );
+        }
+        // NaN is the middle, not an end.
+        assert_eq!(diverging(f64::NAN), diverging(0.5));
+    }
 }

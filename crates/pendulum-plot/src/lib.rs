@@ -150,8 +150,9 @@ impl CategoryScatter {
 
 /// Heat map on a grid of cells: cell `(ix, iy)` spans `x_edges[ix]..x_edges[ix + 1]` by
 /// `y_edges[iy]..y_edges[iy + 1]` and has the value `values[iy][ix]` (NaN = no data, drawn
-/// grey). Colours follow viridis from `vmin` to `vmax`, shown on a colour bar labelled
-/// `value_label`.
+/// grey). Colours follow viridis from `vmin` to `vmax` (or, with `diverging`, a blue–white–red
+/// scale whose white is the middle, for differences centred on 0), shown on a colour bar
+/// labelled `value_label`.
 #[derive(Debug, Clone)]
 pub struct Heatmap {
     pub title: String,
@@ -171,6 +172,9 @@ pub struct Heatmap {
     /// Cells that get a marker dot, as `(ix, iy)` (same order as the edges, i.e. the cell
     /// holding `values[iy][ix]`). Out-of-range entries are ignored.
     pub marks: Vec<(usize, usize)>,
+    /// A diverging colour scale (blue below the middle of `vmin..vmax`, white at it, red above)
+    /// instead of viridis: for signed differences, where 0 must read as "no difference".
+    pub diverging: bool,
     pub width: u32,
     pub height: u32,
 }
@@ -188,6 +192,7 @@ impl Default for Heatmap {
             vmin: None,
             vmax: None,
             marks: Vec::new(),
+            diverging: false,
             width: 1000,
             height: DEFAULT_SIZE.1,
         }
