@@ -145,6 +145,62 @@ fn check_count(command: &str, shard: Shard, total: usize, cell: &str) -> Result<
     Ok(())
 }
 
+/// What a map command's shard is: its name, what one cell is, how many cells the whole map has,
+/// the simulations each cell runs, and the job as recorded in the manifest (threads left out:
+/// they change no result).
+struct ShardRun<'a> {
+    command: &'static str,
+    cell: &'a str,
+    total: usize,
+    sims_per_cell: u64,
+    job: serde_json::Value,
+}
+
+/// Runs shard `shard` of a map command and writes it into `out/shard=i/`: the one driver of the
+/// three map commands' shards; `run` computes the given cells' rows of the one-machine table.
+fn run_shard(
+    r: ShardRun<'_>,
+    table_metadata: &[(String, String)],
+    shard: Shard,
+    out: &Path,
+    show_progress: bool,
+    run: impl FnOnce(&[usize], &(dyn Fn(u64) + Sync)) -> Result<Vec<Column>, JobError>,
+) -> Result<ShardSummary, JobError> {
+    check_count(r.command, shard, r.total, r.cell)?;
+    let cells = shard.cells(r.total);
+    crate::bifurcate::create_dir(&out.join(shard.dir_name()))?;
+    let sims = cells.len() as u64 * r.sims_per_cell;
+    let bar = crate::bifurcate::progress_bar(sims, &format!("{} shard", r.command), show_progress);
+    let t = std::time::Instant::now();
+    let columns = run(&cells, &|n| bar.inc(n))?;
+    bar.finish_and_clear();
+    let wall_s = t.elapsed().as_secs_f64();
+    let written = shard::write_shard(
+        out,
+        &ShardPart {
+            command: r.command,
+            shard,
+            cell: r.cell,
+            cells_total: r.total,
+            cells: &cells,
+            columns: &columns,
+            table_metadata,
+            job: r.job,
+            wall_s,
+        },
+    )?;
+    Ok(ShardSummary {
+        command: r.command.into(),
+        shard,
+        cells: cells.len(),
+        cells_total: r.total,
+        simulations: sims,
+        wall_s,
+        out: out.to_path_buf(),
+        written,
+    })
+}
+
 /// Runs shard `shard` of a bifurcation sweep and writes it into `out/shard=i/`.
 pub(crate) fn bifurcate_shard(
     job: &BifurcateJob,
@@ -154,46 +210,26 @@ pub(crate) fn bifurcate_shard(
     show_progress: bool,
 ) -> Result<ShardSummary, JobError> {
     let cfg = &job.config;
-    let total = cfg.cells();
-    check_count("bifurcate", shard, total, cfg.cell_description())?;
-    let cells = shard.cells(total);
-    crate::bifurcate::create_dir(&out.join(shard.dir_name()))?;
-    let per_cell = match cfg.mode {
-        bifurcation::Mode::Grid => 1,
-        bifurcation::Mode::Continuation => cfg.sweep.len() as u64,
-    };
-    let sims = cells.len() as u64 * per_cell;
-    let bar = crate::bifurcate::progress_bar(sims, "bifurcate shard", show_progress);
-    let t = std::time::Instant::now();
-    let result = bifurcation::run_cells(cfg, &cells, &|n| bar.inc(n))?;
-    bar.finish_and_clear();
-    let wall_s = t.elapsed().as_secs_f64();
     let mut recorded = job.clone();
     recorded.config.threads = None;
-    let written = shard::write_shard(
-        out,
-        &ShardPart {
-            command: "bifurcate",
-            shard,
-            cell: cfg.cell_description(),
-            cells_total: total,
-            cells: &cells,
-            columns: &result.columns(),
-            table_metadata,
-            job: to_json(&recorded)?,
-            wall_s,
+    let run = ShardRun {
+        command: "bifurcate",
+        cell: cfg.cell_description(),
+        total: cfg.cells(),
+        sims_per_cell: match cfg.mode {
+            bifurcation::Mode::Grid => 1,
+            bifurcation::Mode::Continuation => cfg.sweep.len() as u64,
         },
-    )?;
-    Ok(ShardSummary {
-        command: "bifurcate".into(),
+        job: to_json(&recorded)?,
+    };
+    run_shard(
+        run,
+        table_metadata,
         shard,
-        cells: cells.len(),
-        cells_total: total,
-        simulations: sims,
-        wall_s,
-        out: out.to_path_buf(),
-        written,
-    })
+        out,
+        show_progress,
+        |cells, inc| Ok(bifurcation::run_cells(cfg, cells, inc)?.columns()),
+    )
 }
 
 /// Runs shard `shard` of a zones map and writes it into `out/shard=i/`.
@@ -205,48 +241,28 @@ pub(crate) fn zones_shard(
     show_progress: bool,
 ) -> Result<ShardSummary, JobError> {
     let cfg = &job.config;
-    let total = cfg.cells();
-    let what = "one (x, y) cell with all its starts and models; cell = iy·nx + ix";
-    check_count("zones", shard, total, what)?;
-    let cells = shard.cells(total);
-    crate::bifurcate::create_dir(&out.join(shard.dir_name()))?;
     let list: Vec<(String, Dimensionless)> = job
         .models
         .iter()
         .map(|m| (m.label.clone(), m.params))
         .collect();
-    let sims = (cells.len() * cfg.starts.len() * list.len()) as u64;
-    let bar = crate::bifurcate::progress_bar(sims, "zones shard", show_progress);
-    let t = std::time::Instant::now();
-    let maps = zones::run_cells(&list, cfg, &cells, &|n| bar.inc(n))?;
-    bar.finish_and_clear();
-    let wall_s = t.elapsed().as_secs_f64();
     let mut recorded = job.clone();
     recorded.config.threads = None;
-    let written = shard::write_shard(
-        out,
-        &ShardPart {
-            command: "zones",
-            shard,
-            cell: what,
-            cells_total: total,
-            cells: &cells,
-            columns: &zones::columns(&maps)?,
-            table_metadata,
-            job: to_json(&recorded)?,
-            wall_s,
-        },
-    )?;
-    Ok(ShardSummary {
-        command: "zones".into(),
+    let run = ShardRun {
+        command: "zones",
+        cell: "one (x, y) cell with all its starts and models; cell = iy·nx + ix",
+        total: cfg.cells(),
+        sims_per_cell: (cfg.starts.len() * list.len()) as u64,
+        job: to_json(&recorded)?,
+    };
+    run_shard(
+        run,
+        table_metadata,
         shard,
-        cells: cells.len(),
-        cells_total: total,
-        simulations: sims,
-        wall_s,
-        out: out.to_path_buf(),
-        written,
-    })
+        out,
+        show_progress,
+        |cells, inc| Ok(zones::columns(&zones::run_cells(&list, cfg, cells, inc)?)?),
+    )
 }
 
 /// Runs shard `shard` of a design search and writes it into `out/shard=i/`.
@@ -259,43 +275,29 @@ pub(crate) fn design_shard(
 ) -> Result<ShardSummary, JobError> {
     use pendulum_maps::design;
     let cfg = &job.config;
-    let total = cfg.cells();
-    check_count("design", shard, total, cfg.cell_description())?;
-    let cells = shard.cells(total);
-    crate::bifurcate::create_dir(&out.join(shard.dir_name()))?;
-    let sims = (cells.len() * cfg.starts.len() * job.models.len()) as u64;
-    let bar = crate::bifurcate::progress_bar(sims, "design shard", show_progress);
-    let t = std::time::Instant::now();
-    let designs = design::run_cells(&job.models, cfg, &cells, &|n| bar.inc(n))?;
-    bar.finish_and_clear();
-    let wall_s = t.elapsed().as_secs_f64();
     let mut recorded = job.clone();
     recorded.config.threads = None;
-    let written = shard::write_shard(
-        out,
-        &ShardPart {
-            command: "design",
-            shard,
-            cell: cfg.cell_description(),
-            cells_total: total,
-            cells: &cells,
-            // `best` needs the whole grid: false here, set by the merge.
-            columns: &design::columns(&designs, false),
-            table_metadata,
-            job: to_json(&recorded)?,
-            wall_s,
-        },
-    )?;
-    Ok(ShardSummary {
-        command: "design".into(),
+    let run = ShardRun {
+        command: "design",
+        cell: cfg.cell_description(),
+        total: cfg.cells(),
+        sims_per_cell: (cfg.starts.len() * job.models.len()) as u64,
+        job: to_json(&recorded)?,
+    };
+    run_shard(
+        run,
+        table_metadata,
         shard,
-        cells: cells.len(),
-        cells_total: total,
-        simulations: sims,
-        wall_s,
-        out: out.to_path_buf(),
-        written,
-    })
+        out,
+        show_progress,
+        |cells, inc| {
+            // `best` needs the whole grid: false here, set by the merge.
+            Ok(design::columns(
+                &design::run_cells(&job.models, cfg, cells, inc)?,
+                false,
+            ))
+        },
+    )
 }
 
 /// `pendulum merge` options.
