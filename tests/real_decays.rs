@@ -224,7 +224,8 @@ fn identify(camp: &Path, out: &Path) -> String {
 /// decay's fit agrees with its envelope (the large one after its quadratic drag, below the
 /// envelope's interval in the plain fit, is put back); fitted together (one ω0 and one damping
 /// for two recordings whose envelopes differ), the verdict says the views disagree instead of
-/// forcing either, and a damping term of 4e-4 is not called "at its lower bound 0".
+/// forcing either, and a damping term of 4e-4 is not called "at its lower bound 0". Their own
+/// fits (issue 16 item 4) are in `runs.parquet`, each ω0 within 1 % of its swings' periods.
 #[test]
 fn regression_issue_16_multiarm_identify_one_decay_law() {
     let Some(dir) = data_dir("regression_issue_16_multiarm_identify_one_decay_law") else {
@@ -271,5 +272,16 @@ fn regression_issue_16_multiarm_identify_one_decay_law() {
             v.abs() < 1e-6,
             "a damping term of a measurable size called unused: {l}"
         );
+    }
+    // Issue 16 item 4: the two decays' own fits are in runs.parquet, each ω0 within 1 % of the
+    // one its swings' periods say (`omega0_est_rad_s`).
+    let runs = tmp.path().join("out-joint/runs.parquet");
+    let est = crate::identify::column_f64(&runs, "omega0_est_rad_s");
+    let own = crate::identify::column_f64(&runs, "omega0_own_rad_s");
+    let e_own = crate::identify::column_f64(&runs, "e_theta_own");
+    assert_eq!(own.len(), 2);
+    for ((w, want), e) in own.iter().zip(&est).zip(&e_own) {
+        assert!((w - want).abs() < 0.01 * want, "own omega0 {w} vs {want}");
+        assert!(e.is_finite(), "e_theta_own {e}");
     }
 }

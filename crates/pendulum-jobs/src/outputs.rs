@@ -251,6 +251,42 @@ fn ints(name: &str, v: Vec<i64>) -> Column {
     Column::new(name, ColumnData::I64(v))
 }
 
+/// Issue 16 item 4: `runs.parquet`'s columns of each run's own fit (free decays whose ω0 differ
+/// are also fitted one by one, [`pendulum_process::identify::per_run_fits`]): its ω0, its swing
+/// centre (hanging angle, `encoder_offset`), its damping per unit inertia and its E_θ. NaN for a
+/// run without one (runs that share ω0, shaker campaigns) and for a term its model lacks.
+fn own_fit_columns(ctx: &Context, first: Option<&FitOutcome>) -> Vec<Column> {
+    let own = first.and_then(|m| ctx.per_run.get(&m.spec.name));
+    let offset = FitParam::of("encoder_offset");
+    let terms = [
+        ("omega0_own_rad_s", "rad/s", Some(FitParam::Omega0)),
+        ("theta_hang_own_rad", "rad", Some(offset)),
+        ("beta_own", FitParam::Beta.unit(), Some(FitParam::Beta)),
+        ("alpha_own", FitParam::Alpha.unit(), Some(FitParam::Alpha)),
+        ("M_own", FitParam::MBearing.unit(), Some(FitParam::MBearing)),
+        ("c_own", FitParam::DryC.unit(), Some(FitParam::DryC)),
+        ("e_theta_own", "rad", None),
+    ];
+    terms
+        .iter()
+        .map(|&(name, unit, p)| {
+            let vals = ctx
+                .runs
+                .iter()
+                .map(|r| {
+                    own.and_then(|o| o.get(&r.id))
+                        .and_then(|f| match p {
+                            Some(p) => f.spec.value_of(p, &f.params),
+                            None => Some(f.e_theta),
+                        })
+                        .unwrap_or(f64::NAN)
+                })
+                .collect();
+            f64s(name, unit, vals)
+        })
+        .collect()
+}
+
 /// Which quantities a free decay's fit could not separate (the `not_separable` column and the
 /// printed summary): θ(t) gives ω0 and torques per unit inertia only; the campaign's m and l
 /// (pivot to centre of mass), when given, turn them into an inertia and SI torques.
@@ -724,6 +760,7 @@ pub fn write_outputs_checked(
                     .collect(),
             ),
         ));
+        cols.extend(own_fit_columns(ctx, first));
         let p = out.join("runs.parquet");
         inputs.check_output("the output", &p)?;
         opts.clone()

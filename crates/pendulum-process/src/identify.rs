@@ -1321,6 +1321,17 @@ pub fn per_run_fits(
         .collect()
 }
 
+/// The fits of [`per_run_fits`] by run id (what the outputs' per-run columns read).
+pub fn per_run_by_id(
+    runs: &[PreparedRun],
+    fits: &[(FitOutcome, Vec<String>)],
+) -> std::collections::BTreeMap<String, FitOutcome> {
+    runs.iter()
+        .zip(fits)
+        .map(|(r, (fit, _))| (r.id.clone(), fit.clone()))
+        .collect()
+}
+
 /// One note per run of [`per_run_fits`]: its own ω0, hanging angle and damping, E_θ against the
 /// shared fit's on that run, and its parameters at a bound.
 pub fn per_run_notes(

@@ -54,6 +54,10 @@ pub struct Context {
     /// Each run's angle resolution, rad, where its capture states it (`counts_per_rev`): it
     /// bounds the free-decay envelope the fit is checked against.
     pub resolutions: BTreeMap<String, f64>,
+    /// Issue 16 item 4: the per-run fits of free decays that do not share ω0
+    /// ([`crate::identify::per_run_fits`]), per fitted model name: run id → the run's own fit.
+    /// Empty for a model whose runs share ω0 (and for shaker campaigns).
+    pub per_run: BTreeMap<String, BTreeMap<String, FitOutcome>>,
 }
 
 impl Context {
@@ -292,6 +296,12 @@ impl Stage for FitStage {
         let alone = crate::identify::per_run_fits(&runs, ctx, &self.0, &out)?;
         ctx.notes
             .extend(crate::identify::per_run_notes(&runs, &out, &alone));
+        if !alone.is_empty() {
+            ctx.per_run.insert(
+                out.spec.name.clone(),
+                crate::identify::per_run_by_id(&runs, &alone),
+            );
+        }
         ctx.notes
             .extend(crate::identify::params_at_bounds(&runs, &out));
         ctx.fits.push(out);
