@@ -342,7 +342,12 @@ pub fn plot_power_comparison(
         ..a.heatmap(String::new(), Vec::new())
     };
     let input = map(
-        format!("input power, {} minus {}", a.label, b.label),
+        format!(
+            "input power, {} minus {} (mean over {} starts per cell)",
+            a.label,
+            b.label,
+            a.config.starts.len()
+        ),
         base,
         sb,
     );
@@ -364,11 +369,11 @@ pub fn plot_power_comparison(
     save_heatmaps_side_by_side(
         &panels,
         &if no_load {
+            // One panel is narrower than two: a short title (the starts are in the panel's).
             format!(
-                "Where {} and {} disagree in input power (W; mean over {} starts per cell; no generator load in either model): largest gap {} W",
+                "Input power, {} − {}: no generator in either model; largest gap {} W",
                 a.label,
                 b.label,
-                a.config.starts.len(),
                 crate::style::fmt_num(sb)
             )
         } else {
