@@ -90,6 +90,22 @@ fn twin_series(seed: u64) -> (Twin, f64, String) {
 }
 
 /// The value of `name = v` in a line of `pendulum identify`'s model summary.
+/// `pendulum identify --model reference` on a campaign folder into `out`: its printed report
+/// (stdout, echoed with stderr); panics, showing both, unless it succeeded.
+fn identify(camp: &Path, out: &Path) -> String {
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_pendulum"))
+        .args(["identify", "--quiet", "--model", "reference", "--out"])
+        .arg(out)
+        .arg(camp)
+        .output()
+        .expect("run pendulum identify");
+    let text = String::from_utf8_lossy(&o.stdout).into_owned();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{text}\n{err}");
+    print!("{text}{err}");
+    text
+}
+
 fn fitted(text: &str, name: &str) -> f64 {
     let line = text
         .lines()
@@ -109,16 +125,7 @@ fn regression_issue_16_twin_decays_one_decay_law() {
         std::fs::create_dir_all(&camp).expect("campaign dir");
         let twin = twin_run(&camp, seed);
         let out = tmp.path().join(format!("out{seed}"));
-        let o = std::process::Command::new(env!("CARGO_BIN_EXE_pendulum"))
-            .args(["identify", "--quiet", "--model", "reference", "--out"])
-            .arg(&out)
-            .arg(&camp)
-            .output()
-            .expect("run pendulum identify");
-        let text = String::from_utf8_lossy(&o.stdout).into_owned();
-        let err = String::from_utf8_lossy(&o.stderr);
-        assert!(o.status.success(), "{text}\n{err}");
-        print!("{text}{err}");
+        let text = identify(&camp, &out);
         let verdict = text
             .lines()
             .find(|l| l.starts_with(&format!("note: decay law, run twin{seed}:")))
@@ -198,16 +205,7 @@ fn regression_issue_16_item_4_per_run_omega0_in_runs_parquet() {
     );
     std::fs::write(camp.join("campaign.toml"), toml).expect("write campaign");
     let out = tmp.path().join("out");
-    let o = std::process::Command::new(env!("CARGO_BIN_EXE_pendulum"))
-        .args(["identify", "--quiet", "--model", "reference", "--out"])
-        .arg(&out)
-        .arg(&camp)
-        .output()
-        .expect("run pendulum identify");
-    let text = String::from_utf8_lossy(&o.stdout).into_owned();
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert!(o.status.success(), "{text}\n{err}");
-    print!("{text}{err}");
+    identify(&camp, &out);
     let runs = out.join("runs.parquet");
     let ids = crate::identify::column_str(&runs, "run_id");
     assert_eq!(ids, ["twin1", "twin3"]);
@@ -246,18 +244,7 @@ fn regression_issue_16_item_4_per_run_omega0_in_runs_parquet() {
     let (_, _, csv) = twin_series(1);
     std::fs::write(camp.join("twin3.tsv"), csv).expect("write twin");
     let out = tmp.path().join("out-shared");
-    let o = std::process::Command::new(env!("CARGO_BIN_EXE_pendulum"))
-        .args(["identify", "--quiet", "--model", "reference", "--out"])
-        .arg(&out)
-        .arg(&camp)
-        .output()
-        .expect("run pendulum identify");
-    let text = String::from_utf8_lossy(&o.stdout).into_owned();
-    assert!(
-        o.status.success(),
-        "{text}\n{}",
-        String::from_utf8_lossy(&o.stderr)
-    );
+    let text = identify(&camp, &out);
     assert!(!text.contains("alone"), "{text}");
     let runs = out.join("runs.parquet");
     for c in OWN_COLUMNS {
