@@ -28,6 +28,7 @@
 //! `unexplained`, with where it lives.
 
 use pendulum_fit::{Cost, Problem};
+use pendulum_model::effects::Kind;
 use pendulum_process::align::fit_speed_drift;
 use pendulum_process::fit::{FitParam, ModelSpec, PreparedRun, StudyObjective};
 use pendulum_process::identify::{validate, FitOutcome, RunFit, ValidateConfig};
@@ -227,7 +228,9 @@ impl View {
             // The shaped columns stay out: a shape is the screen's to choose, and a profile
             // here moved every later step's weights (a hidden dry torque's refit with them).
             let id_rows: Vec<WeakRow> = weak.iter().filter(|r| is_id(r)).cloned().collect();
-            let all: Vec<usize> = (0..=crate::weak::DELAY).chain(zero_cols.clone()).collect();
+            let all: Vec<usize> = (0..crate::weak::columns().len())
+                .chain(zero_cols.clone())
+                .collect();
             let base_cols: Vec<usize> = base
                 .columns()
                 .into_iter()
@@ -269,17 +272,24 @@ impl View {
         let rows = &self.val_rows;
         let mut res = fit.residuals(rows);
         let runs: std::collections::BTreeSet<usize> = rows.iter().map(|r| r.run).collect();
+        let Some(offset) = crate::weak::observation_column() else {
+            return res
+                .iter()
+                .zip(rows)
+                .map(|(e, r)| r.weight * e * e)
+                .collect();
+        };
         for run in runs {
             let idx: Vec<usize> = (0..rows.len()).filter(|&i| rows[i].run == run).collect();
             let (mut sxy, mut sxx) = (0.0, 0.0);
             for &i in &idx {
-                let (x, w) = (rows[i].x[crate::weak::OFFSET], rows[i].weight);
+                let (x, w) = (rows[i].x[offset], rows[i].weight);
                 sxy += w * x * res[i];
                 sxx += w * x * x;
             }
             if sxx > 0.0 {
                 for &i in &idx {
-                    res[i] -= sxy / sxx * rows[i].x[crate::weak::OFFSET];
+                    res[i] -= sxy / sxx * rows[i].x[offset];
                 }
             }
         }
@@ -318,63 +328,21 @@ impl View {
 /// run's inertia divisor, so the coefficients are the SI parameters themselves whatever bobs and
 /// cranks the campaign mixes.
 fn to_si(c: &Candidate, fit: &crate::screen::Ols) -> (f64, f64, &'static str) {
-    let first = |col: usize| fit.coef_of(col).unwrap_or((f64::NAN, f64::NAN));
-    match c.effect.as_str() {
-        "viscous_linear" => {
-            let (v, e) = first(0);
-            (v, e, "N·s/m")
-        }
-        "viscous_quadratic" => {
-            let (v, e) = first(1);
-            (v, e, "kg/m")
-        }
-        "coulomb_bearing" => {
-            let (v, e) = first(2);
-            (v, e, "1")
-        }
-        "bearing_load_base_accel" => {
-            let (v, e) = first(3);
-            (v, e, "1")
-        }
-        "coulomb_constant" => {
-            let (v, e) = first(4);
-            (v, e, "N·m")
-        }
-        "position_torque" => {
-            let (a, ea) = first(c.add[0]);
-            let (b, eb) = first(c.add[1]);
-            let p = a.hypot(b);
-            let se = ((a * ea).powi(2) + (b * eb).powi(2)).sqrt() / p.max(1e-300);
-            (p, se, "N·m")
-        }
-        "horizontal_base" => {
-            let (v, e) = first(13);
-            (v.atan(), e / (1.0 + v * v), "rad")
-        }
-        "extra_inertia" => {
-            let (v, e) = first(crate::weak::INERTIA);
-            (v, e, "kg·m²")
-        }
-        "encoder_offset" => {
-            let (v, e) = first(crate::weak::OFFSET);
-            (-v, e, "rad")
-        }
-        "accel_delay" => {
-            let (v, e) = first(crate::weak::DELAY);
-            (v, e, "s")
-        }
-        // A torque shaped by a speed scale: its column's coefficient is the effect's size.
-        _ => match c.shaped() {
-            Some(sh) => {
-                let (v, e) = first(sh.col);
-                let unit = pendulum_model::effects::by_name(sh.effect)
-                    .and_then(|e| e.params().first())
-                    .map_or("-", |p| p.unit);
-                (v, e, unit)
-            }
-            None => (f64::NAN, f64::NAN, "-"),
-        },
-    }
+    let Some(e) = pendulum_model::effects::by_name(&c.effect) else {
+        return (f64::NAN, f64::NAN, "-");
+    };
+    let coef: Vec<(f64, f64)> = c
+        .add
+        .iter()
+        .map(|&col| fit.coef_of(col).unwrap_or((f64::NAN, f64::NAN)))
+        .collect();
+    // A shaped column's coefficient is the effect's size itself (written in SI torque).
+    let (v, se) = if c.shaped().is_some() {
+        coef[0]
+    } else {
+        e.estimate(&coef)
+    };
+    (v, se, e.size_unit())
 }
 
 /// Effects whose size is within the rig's normal tolerances are not named: the encoder is zeroed
@@ -828,40 +796,40 @@ fn extend(
     let mut out = spec.clone();
     let (est, _, _) = to_si(c, fit);
     let mut news = Vec::new();
-    match c.effect.as_str() {
-        // A switch: held on, its bearing friction refitted (already a parameter of the base).
-        "bearing_load_base_accel" => out.fixed.set("bearing_load_base_accel", Some(Vec::new())),
-        "position_torque" => {
-            let a = fit.coef_of(c.add[0]).map_or(0.0, |x| x.0);
-            let b = fit.coef_of(c.add[1]).map_or(0.0, |x| x.0);
-            // k is the candidate's; T_p and φ_p are refitted.
-            out.fixed
-                .set("position_torque", Some(vec![0.0, c.k as f64, 0.0]));
-            news.push((FitParam::of("position_torque"), est));
-            news.push((FitParam::of("position_torque.phi_p"), b.atan2(a)));
-        }
-        // A shaped column's effect: its size and the shape the screen's profile found, both
-        // refitted (the size first: it is what is judged).
-        _ if c.shaped().is_some() => {
-            let sh = c.shaped().expect("checked");
-            if let (Some(e), Some(p)) = (
-                pendulum_model::effects::by_name(&c.effect),
-                FitParam::find(sh.shape.key),
-            ) {
-                if let Some(size) = e.params().first().and_then(|q| FitParam::find(q.key)) {
-                    let lo = size.bounds().0;
-                    out.fixed.set(&c.effect, Some(vec![est.max(lo), c.shape]));
-                    news.push((size, est.max(lo)));
-                    news.push((p, c.shape));
-                }
+    let Some(e) = pendulum_model::effects::by_name(&c.effect) else {
+        return (out, news);
+    };
+    if e.params().is_empty() {
+        // A switch (bearing_load_base_accel): held on; the reference parameter it changes is
+        // already a parameter of the base and is refitted from the screen's value.
+        out.fixed.set(&c.effect, Some(Vec::new()));
+    } else {
+        // The size starts at the screen's estimate inside its catalogue range's sign (a
+        // non-negative parameter never starts below 0); the effect says where the rest start
+        // (position_torque: its k, held, and φ_p from its two columns; a shaped torque: the shape
+        // the screen's profile found).
+        let lo = e
+            .size_key()
+            .and_then(FitParam::find)
+            .map_or(f64::NEG_INFINITY, |p| p.bounds().0);
+        let size = if lo >= 0.0 { est.max(lo) } else { est };
+        let coef: Vec<f64> = c
+            .add
+            .iter()
+            .map(|&col| fit.coef_of(col).map_or(0.0, |x| x.0))
+            .collect();
+        let mut values = e.refit_start(size, &coef, c.k);
+        if let Some(sh) = c.shaped() {
+            if let Some(i) = e.params().iter().position(|p| p.key == sh.shape.key) {
+                values[i] = c.shape;
             }
         }
-        // One refitted parameter, started at the screen's estimate inside its catalogue range's
-        // sign (a non-negative parameter never starts below 0).
-        name => {
-            if let Some(p) = FitParam::find(name) {
-                let lo = p.bounds().0;
-                news.push((p, if lo >= 0.0 { est.max(lo) } else { est }));
+        if e.params().len() > 1 {
+            out.fixed.set(&c.effect, Some(values.clone()));
+        }
+        for (p, v) in e.params().iter().zip(&values) {
+            if let Some(fp) = p.fit_range.and_then(|_| FitParam::find(p.key)) {
+                news.push((fp, *v));
             }
         }
     }
@@ -1290,11 +1258,14 @@ pub fn discover(
         // An effect that enters nonlinearly (an encoder offset, an accelerometer lag) is applied
         // exactly to the measured motion and its estimate refined there before it is judged:
         // the regression's column has it only to first order (a 0.066 rad offset read 0.053).
-        let nonlinear = matches!(c.effect.as_str(), "encoder_offset" | "accel_delay");
+        let Some(effect) = pendulum_model::effects::by_name(&c.effect) else {
+            break;
+        };
+        let nonlinear = matches!(effect.kind(), Kind::Observation | Kind::Input);
         let mut refined: Option<(View, Correction)> = None;
         if nonlinear {
-            let set = |corr: &mut Correction, v: f64| match c.effect.as_str() {
-                "encoder_offset" => corr.theta_off_rad = v,
+            let set = |corr: &mut Correction, v: f64| match effect.kind() {
+                Kind::Observation => corr.theta_off_rad = v,
                 _ => corr.delay_s = v,
             };
             let mut corr = correction.clone();
@@ -1318,6 +1289,12 @@ pub fn discover(
             ));
         }
         let (spec, mut news) = extend(&current.spec, c, &fit);
+        // Where the refit holds the effect's size: its own first parameter, or the reference
+        // parameter a switch changes (μ for bearing_load_base_accel).
+        let size_index = effect
+            .size_key()
+            .and_then(FitParam::find)
+            .and_then(|p| spec.params.iter().position(|q| *q == p));
         if nonlinear {
             if let Some(n) = news.first_mut() {
                 n.1 = est;
@@ -1338,18 +1315,20 @@ pub fn discover(
         // constant dry torque inflates μ): a local refit from there need not find its way back.
         for (i, p) in spec.params.iter().enumerate() {
             let si = match p {
-                FitParam::B => fit.coef_of(0),
-                FitParam::A => fit.coef_of(1),
-                FitParam::Mu => fit.coef_of(2),
+                FitParam::B | FitParam::A | FitParam::Mu => p
+                    .effect_name()
+                    .and_then(crate::weak::column_of)
+                    .and_then(|col| fit.coef_of(col)),
                 _ => None,
             };
             if let Some(v) = si.map(|(v, _)| v).filter(|v| v.is_finite()) {
                 x0[i] = v.max(0.0);
             }
         }
-        // bearing_load_base_accel refits μ on the new load.
-        if c.effect == "bearing_load_base_accel" {
-            if let Some(i) = spec.params.iter().position(|p| *p == FitParam::Mu) {
+        // A switch refits the reference parameter it changes from the screen's value (μ on the
+        // bearing load with the base's acceleration).
+        if effect.params().is_empty() {
+            if let Some(i) = size_index {
                 x0[i] = est.max(0.0);
             }
         }
@@ -1393,18 +1372,8 @@ pub fn discover(
         // study's setting the validate runs' segments scatter by ±10–20 %, more than a dry torque
         // that μ half absorbs moves them, while their equation error tells the models apart.
         let held_out = gain > gain_needed || (eq_gain > eq_needed && gain > -noise);
-        // The refitted value of the effect's first parameter (μ for bearing_load_base_accel).
-        let refit_est = match c.effect.as_str() {
-            "bearing_load_base_accel" => spec
-                .params
-                .iter()
-                .position(|p| *p == FitParam::Mu)
-                .map_or(f64::NAN, |i| x[i]),
-            _ => news
-                .first()
-                .and_then(|(p, _)| spec.params.iter().position(|q| q == p))
-                .map_or(f64::NAN, |i| x[i]),
-        };
+        // The refitted value of the effect's size.
+        let refit_est = size_index.map_or(f64::NAN, |i| x[i]);
         let possible = physically_possible(&c.effect, est);
         // The refit's own interval: is the screen's model (its joint estimate of the damping
         // and the effect, where the refit started) significantly worse on the identify runs'
@@ -1413,12 +1382,7 @@ pub fn discover(
         let screen_fits_trajectories = {
             // The profile through the screen's value: the other parameters refitted with the
             // effect's held at the screen's estimate.
-            let i = match c.effect.as_str() {
-                "bearing_load_base_accel" => spec.params.iter().position(|p| *p == FitParam::Mu),
-                _ => news
-                    .first()
-                    .and_then(|(p, _)| spec.params.iter().position(|q| q == p)),
-            };
+            let i = size_index;
             let x_prof = match i {
                 Some(i) => {
                     let mut start = x0.clone();
@@ -1434,7 +1398,7 @@ pub fn discover(
             // mislabelled encoder passed a profile test with no power. (The bearing load's μ
             // has no absence to compare with.)
             let informative = match i {
-                Some(i) if c.effect != "bearing_load_base_accel" => {
+                Some(i) if !effect.params().is_empty() => {
                     let mut x_zero = x.clone();
                     x_zero[i] = 0.0;
                     let (g0, n0) =

@@ -9,7 +9,8 @@
 use serde::{Deserialize, Serialize};
 
 use crate::weak::{
-    is_dynamics, set_shape, shaped, shaped_columns, WeakRow, DELAY, INERTIA, OFFSET,
+    column_of, group_columns, is_dynamics, mass_column, observation_column, set_shape, shaped,
+    shaped_columns, WeakRow,
 };
 
 /// The base models discover starts from.
@@ -33,13 +34,18 @@ impl Base {
         }
     }
 
+    /// The catalogue's reference-model terms it holds.
+    pub fn effects(self) -> &'static [&'static str] {
+        match self {
+            Base::Reference => &["viscous_linear", "viscous_quadratic", "coulomb_bearing"],
+            Base::Linear => &["viscous_linear"],
+            Base::Dry => &["coulomb_bearing"],
+        }
+    }
+
     /// Column indices of the base's own terms.
     pub fn columns(self) -> Vec<usize> {
-        match self {
-            Base::Reference => vec![0, 1, 2],
-            Base::Linear => vec![0],
-            Base::Dry => vec![2],
-        }
+        self.effects().iter().filter_map(|e| column_of(e)).collect()
     }
 }
 
@@ -72,57 +78,47 @@ impl Candidate {
     }
 }
 
-/// The candidates for a base model.
+/// The candidates for a base model, from the catalogue in its order: every effect with a
+/// weak-form column ([`crate::weak::columns`], one candidate per group, such as position_torque's
+/// k) or a shaped one ([`shaped_columns`]) that the base does not hold. An effect that replaces
+/// a reference term's column (bearing_load_base_accel: the bearing load) is a candidate only
+/// where the base holds that term with the viscous drag beside it (the reference model): in a
+/// one-term base the swapped load would stand in for the missing drag.
 pub fn candidates(base: Base) -> Vec<Candidate> {
     let mut out = Vec::new();
-    let cand = |effect: &str, add: Vec<usize>| Candidate {
-        effect: effect.into(),
-        add,
-        replaces: None,
-        k: 0,
-        shape: 0.0,
-        size_band: None,
-    };
-    if base == Base::Linear {
-        out.push(cand("viscous_quadratic", vec![1]));
-        out.push(cand("coulomb_bearing", vec![2]));
+    for e in pendulum_model::CATALOGUE {
+        if base.effects().contains(&e.name()) {
+            continue;
+        }
+        let replaces = match e.replaces() {
+            Some(r) if base == Base::Reference => column_of(r),
+            Some(_) => continue,
+            None => None,
+        };
+        if let Some(sh) = shaped_columns().iter().find(|s| s.effect == e.name()) {
+            out.push(Candidate {
+                effect: e.name().into(),
+                add: vec![sh.col],
+                replaces,
+                k: 0,
+                shape: f64::NAN,
+                size_band: None,
+            });
+            continue;
+        }
+        let mut groups: Vec<u32> = e.regressors().iter().map(|r| r.group).collect();
+        groups.dedup();
+        for k in groups {
+            out.push(Candidate {
+                effect: e.name().into(),
+                add: group_columns(e.name(), k),
+                replaces,
+                k,
+                shape: 0.0,
+                size_band: None,
+            });
+        }
     }
-    if base == Base::Dry {
-        out.push(cand("viscous_linear", vec![0]));
-        out.push(cand("viscous_quadratic", vec![1]));
-    }
-    if base == Base::Reference {
-        out.push(Candidate {
-            effect: "bearing_load_base_accel".into(),
-            add: vec![3],
-            replaces: Some(2),
-            k: 0,
-            shape: 0.0,
-            size_band: None,
-        });
-    }
-    out.push(cand("coulomb_constant", vec![4]));
-    for k in 1..=4u32 {
-        let i = 5 + 2 * (k as usize - 1);
-        out.push(Candidate {
-            effect: "position_torque".into(),
-            add: vec![i, i + 1],
-            replaces: None,
-            k,
-            shape: 0.0,
-            size_band: None,
-        });
-    }
-    for sh in shaped_columns() {
-        out.push(Candidate {
-            shape: f64::NAN,
-            ..cand(sh.effect, vec![sh.col])
-        });
-    }
-    out.push(cand("horizontal_base", vec![13]));
-    out.push(cand("extra_inertia", vec![14]));
-    out.push(cand("encoder_offset", vec![OFFSET]));
-    out.push(cand("accel_delay", vec![DELAY]));
     out
 }
 
@@ -199,7 +195,8 @@ fn design(r: &WeakRow, c: usize, inertia_kg_m2: f64) -> f64 {
 /// the divisor is a common factor and this is the exact inversion j = c/(1 − c) of the old
 /// single-rig regression.
 pub fn ols(rows: &[WeakRow], columns: &[usize]) -> Option<Ols> {
-    let Some(ji) = columns.iter().position(|&c| c == INERTIA) else {
+    let inertia = mass_column();
+    let Some(ji) = columns.iter().position(|&c| Some(c) == inertia) else {
         return ols_at(rows, columns, 0.0);
     };
     // The smallest bob inertia bounds J from below (1 + J/I must stay positive).
@@ -238,7 +235,7 @@ pub fn ols(rows: &[WeakRow], columns: &[usize]) -> Option<Ols> {
             .filter(|(c, _)| is_dynamics(**c))
             .map(|(&c, b)| r.x[c] * b)
             .sum();
-        f * r.x[INERTIA] - f * f * s / r.bob_inertia_kg_m2
+        f * r.x[columns[ji]] - f * f * s / r.bob_inertia_kg_m2
     };
     if let Some(se) = weighted_se(rows, p, fit.rss, &jac) {
         fit.se = se;
@@ -488,9 +485,10 @@ pub const ENCODER_OFFSET_FLOOR_RAD: f64 = 4.0 * 2.0 * std::f64::consts::PI / 409
 /// is kept in the regression as a nuisance term (so that its torque, e.g. a one-count zero error's
 /// m g l θ_off cos θ, is not mistaken for a position torque) but never named.
 pub fn is_nuisance(s: &Screened) -> bool {
-    s.candidate.effect == "encoder_offset"
+    let offset = observation_column();
+    offset.is_some_and(|c| s.candidate.add == [c])
         && s.fit
-            .coef_of(OFFSET)
+            .coef_of(offset.unwrap_or(usize::MAX))
             .is_some_and(|(v, _)| v.abs() <= ENCODER_OFFSET_FLOOR_RAD)
 }
 
@@ -591,23 +589,28 @@ mod tests {
     fn inertia_divisor_per_run_is_inverted_exactly() {
         let (b, t_c, j, off) = (0.45, 0.012, 0.008, -0.003);
         let bobs = [0.1025, 0.0504];
+        let (inertia, offset) = (mass_column().unwrap(), observation_column().unwrap());
+        let (lin, dry) = (
+            column_of("viscous_linear").unwrap(),
+            column_of("coulomb_constant").unwrap(),
+        );
         let mut rows = Vec::new();
         for (r, bob) in bobs.iter().enumerate() {
             for i in 0..200 {
                 let u = (i * 13 + r * 7) as f64;
-                let mut x = vec![0.0; DELAY + 1];
-                x[0] = (u * 0.37).sin() * 3.0;
-                x[4] = (u * 0.11).cos().signum() / (1.3 - 0.6 * r as f64);
-                x[INERTIA] = (u * 0.23).sin() / bob;
-                x[OFFSET] = (u * 0.19).cos();
-                let dynamics = b * x[0] + t_c * x[4] + j * x[INERTIA];
-                let target = dynamics / (1.0 + j / bob) + off * x[OFFSET];
+                let mut x = vec![0.0; crate::weak::columns().len()];
+                x[lin] = (u * 0.37).sin() * 3.0;
+                x[dry] = (u * 0.11).cos().signum() / (1.3 - 0.6 * r as f64);
+                x[inertia] = (u * 0.23).sin() / bob;
+                x[offset] = (u * 0.19).cos();
+                let dynamics = b * x[lin] + t_c * x[dry] + j * x[inertia];
+                let target = dynamics / (1.0 + j / bob) + off * x[offset];
                 rows.push(row(r, *bob, x, target));
             }
         }
-        let cols = [0, 4, INERTIA, OFFSET];
+        let cols = [lin, dry, inertia, offset];
         let fit = ols(&rows, &cols).unwrap();
-        for (col, truth) in [(0, b), (4, t_c), (INERTIA, j), (OFFSET, off)] {
+        for (col, truth) in [(lin, b), (dry, t_c), (inertia, j), (offset, off)] {
             let (v, se) = fit.coef_of(col).unwrap();
             assert!(
                 (v - truth).abs() < 1e-9 * truth.abs(),

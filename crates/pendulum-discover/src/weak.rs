@@ -11,41 +11,65 @@
 //! Windows where the pendulum sticks (the friction force is then static and unknown), gaps, and
 //! the shaker's spin-up are left out.
 
-use pendulum_model::effects::RateShape;
+use pendulum_model::effects::{Kind, RateShape};
 use pendulum_model::excitation::{crank_f1, crank_f2};
+use pendulum_model::{Effect, Physical, Regressor, WeakSample, CATALOGUE};
 use pendulum_process::{Alignment, RunData};
 use serde::{Deserialize, Serialize};
 
-/// Regressors (each ∫K·term over a window, in dimensionless units of θ̈ of the row's own run),
-/// each multiplied by its run's [`si_factors`] so that its coefficient is the SI parameter of
+/// A weak-form column of a catalogue effect ([`Effect::regressors`]): each ∫K·term over a
+/// window, in dimensionless units of θ̈ of the row's own run, times its run's factor from the
+/// SI parameter ([`Regressor::per_si`]), so that its coefficient is the SI parameter of
 /// effects.md, the same for every run of a campaign that mixes bobs and cranks.
-pub const TERMS: [&str; 16] = [
-    "lin",       // θ̇
-    "quad",      // θ̇|θ̇|
-    "coul_ref",  // |θ̇² + cos θ| sgn θ̇
-    "coul_base", // |θ̇² + (1 + A_y) cos θ| sgn θ̇
-    "const",     // sgn θ̇
-    "pos1_sin",
-    "pos1_cos",
-    "pos2_sin",
-    "pos2_cos",
-    "pos3_sin",
-    "pos3_cos",
-    "pos4_sin",
-    "pos4_cos",
-    "horiz",   // A_y cos θ
-    "inertia", // −(1 + A_y) sin θ: the model's θ̈, a noise-free stand-in for the measured θ̈
-    "offset",  // (1 + A_y) cos θ
-];
+#[derive(Debug, Clone, Copy)]
+pub struct Column {
+    pub effect: &'static dyn Effect,
+    pub reg: &'static Regressor,
+}
 
-/// Index of the extra-inertia regressor −(1 + A_y) sin θ / (m l²) in [`WeakRow::x`].
-pub const INERTIA: usize = 14;
+/// The regression's columns from the catalogue: every effect's regressors, in the catalogue's
+/// order (the index in [`WeakRow::x`] is the position here), then the shaped columns
+/// ([`shaped_columns`]).
+pub fn columns() -> &'static [Column] {
+    static COLS: std::sync::OnceLock<Vec<Column>> = std::sync::OnceLock::new();
+    COLS.get_or_init(|| {
+        CATALOGUE
+            .iter()
+            .flat_map(|&effect| {
+                effect
+                    .regressors()
+                    .iter()
+                    .map(move |reg| Column { effect, reg })
+            })
+            .collect()
+    })
+}
 
-/// Index of the encoder-offset regressor (1 + A_y) cos θ in [`WeakRow::x`].
-pub const OFFSET: usize = 15;
+/// The first column of an effect (its only one, unless its candidates come in groups).
+pub fn column_of(effect: &str) -> Option<usize> {
+    columns().iter().position(|c| c.effect.name() == effect)
+}
 
-/// Index of the accel-delay regressor in [`WeakRow::x`] (after [`TERMS`]).
-pub const DELAY: usize = TERMS.len();
+/// The columns of one candidate of an effect (its group, see [`Regressor::group`]).
+pub fn group_columns(effect: &str, group: u32) -> Vec<usize> {
+    (0..columns().len())
+        .filter(|&i| columns()[i].effect.name() == effect && columns()[i].reg.group == group)
+        .collect()
+}
+
+/// The column of the inertia beside the bob's (the catalogue's mass effect): the screen divides
+/// the dynamics columns by 1 + J/(m l²) of each run.
+pub fn mass_column() -> Option<usize> {
+    columns().iter().position(|c| c.effect.kind() == Kind::Mass)
+}
+
+/// The column of the encoder's reading offset (the catalogue's observation effect): also the
+/// template of the per-run zeroing contrasts ([`add_zero_error_contrasts`]).
+pub fn observation_column() -> Option<usize> {
+    columns()
+        .iter()
+        .position(|c| c.effect.kind() == Kind::Observation)
+}
 
 /// A column whose regressor depends on a parameter that is not a coefficient (a speed scale):
 /// one per catalogue effect with a [`RateShape`], after the accel-delay column, in the
@@ -67,7 +91,7 @@ pub fn shaped_columns() -> &'static [Shaped] {
             .filter_map(|e| e.rate_shape().map(|s| (e.name(), s)))
             .enumerate()
             .map(|(i, (effect, shape))| Shaped {
-                col: DELAY + 1 + i,
+                col: columns().len() + i,
                 effect,
                 shape,
             })
@@ -90,7 +114,7 @@ pub fn shaped_column(effect: &str) -> Option<usize> {
 
 /// Width of [`WeakRow::x`] before the per-run zeroing contrasts.
 pub fn width() -> usize {
-    DELAY + 1 + shaped_columns().len()
+    columns().len() + shaped_columns().len()
 }
 
 /// Writes the shaped column `col` of every row for the shape `value` (SI), from each window's
@@ -114,32 +138,31 @@ pub fn set_shape(rows: &mut [WeakRow], col: usize, value: f64) {
 /// extra inertia, (1 + j)θ̈ = −G − D: the dynamics reach the target divided by 1 + j_r, the
 /// sensor terms (errors of the measured θ and A_y that the target is computed from) do not.
 pub fn is_dynamics(col: usize) -> bool {
-    col < OFFSET || shaped(col).is_some()
+    shaped(col).is_some()
+        || columns()
+            .get(col)
+            .is_some_and(|c| matches!(c.effect.kind(), Kind::Dynamics | Kind::Mass))
 }
 
 /// Per-run factors from the SI parameters of effects.md to the dimensionless coefficients of the
-/// run's own equation (`Physical::to_dimensionless`): β = b/(m ω0), α = a l/m, M = μ r_b/l,
-/// c = T_c/(m g l), p = T_p/(m g l), tan δ, j = J/(m l²), −θ_off, Δ ω0. A column multiplied by its
-/// factor has the SI parameter as its coefficient, so runs with different bobs, rods and cranks
-/// share one regression: pooling dimensionless columns would ask a light and a heavy bob for
-/// the same β and c, and their difference leaked into other columns (a 2 ms "accelerometer lag"
-/// on ideal data).
+/// run's own equation ([`Regressor::per_si`]: β = b/(m ω0), α = a l/m, M = μ r_b/l,
+/// c = T_c/(m g l), …), one per column. A column multiplied by its factor has the SI parameter
+/// as its coefficient, so runs with different bobs, rods and cranks share one regression:
+/// pooling dimensionless columns would ask a light and a heavy bob for the same β and c, and
+/// their difference leaked into other columns (a 2 ms "accelerometer lag" on ideal data). The
+/// shaped columns are written in SI torque already (see [`set_shape`]): factor 1.
 pub fn si_factors(rig: &pendulum_process::RigParams) -> Vec<f64> {
-    let w0 = rig.omega0_rad_s();
-    let (m, l) = (rig.m_kg, rig.l_m);
-    let torque = 1.0 / (m * rig.g_m_s2 * l);
-    let mut f = vec![1.0; width()];
-    f[0] = 1.0 / (m * w0);
-    f[1] = l / m;
-    f[2] = rig.r_b_m / l;
-    f[3] = rig.r_b_m / l;
-    f[4] = torque;
-    for v in &mut f[5..13] {
-        *v = torque;
-    }
-    f[INERTIA] = 1.0 / (m * l * l);
-    f[DELAY] = w0;
-    // The shaped columns are written in SI torque already (see `set_shape`).
+    let p = Physical {
+        m_kg: rig.m_kg,
+        l_m: rig.l_m,
+        crank_r_m: rig.crank_r_m,
+        rod_l_m: rig.rod_l_m,
+        r_b_m: rig.r_b_m,
+        g_m_s2: rig.g_m_s2,
+        ..Physical::default()
+    };
+    let mut f: Vec<f64> = columns().iter().map(|c| (c.reg.per_si)(&p)).collect();
+    f.resize(width(), 1.0);
     f
 }
 
@@ -158,8 +181,7 @@ pub struct WeakRow {
     pub a_x_meas: f64,
     /// Target −∫K(θ̈ + (1 + A_y) sin θ): what damping and the effects must explain.
     pub target: f64,
-    /// Regressors: [`TERMS`], the accel-delay term Ȧ_y sin θ, then the shaped columns
-    /// ([`shaped_columns`]).
+    /// Regressors: the catalogue's [`columns`], then the shaped columns ([`shaped_columns`]).
     pub x: Vec<f64>,
     /// Regression weight (inverse residual variance of the row's regime; 1 until
     /// [`set_weights`] is called).
@@ -242,11 +264,14 @@ pub fn set_weights(rows: &mut [WeakRow], residuals: &[f64]) {
 /// zeros: their own zero errors are not fitted.
 pub fn add_zero_error_contrasts(rows: &mut [WeakRow], identify_runs: &[usize]) -> Vec<usize> {
     let width = rows.iter().map(|r| r.x.len()).max().unwrap_or(0);
+    let Some(offset) = observation_column() else {
+        return Vec::new();
+    };
     let k = identify_runs.len().saturating_sub(1);
     let last = identify_runs.last().copied();
     for r in rows.iter_mut() {
         r.x.resize(width, 0.0);
-        let off = r.x[OFFSET];
+        let off = r.x[offset];
         let mut extra = vec![0.0; k];
         if let Some(j) = identify_runs[..k].iter().position(|&q| q == r.run) {
             extra[j] = off;
@@ -437,14 +462,7 @@ pub fn weak_rows(run_idx: usize, run: &RunData, al: &Alignment, cfg: &WeakConfig
                     (0.0, 0.0, f64::NAN)
                 };
 
-                let (sn, cs) = th_i.sin_cos();
-                let sg = if w > 0.0 {
-                    1.0
-                } else if w < 0.0 {
-                    -1.0
-                } else {
-                    0.0
-                };
+                let sn = th_i.sin();
                 let kk = k * wgt * dtt;
                 let lv = crate::sparse::library_values(th_i, w * w0, phase_i, tau, ay);
                 for (li, v) in lib.iter_mut().zip(lv) {
@@ -456,27 +474,14 @@ pub fn weak_rows(run_idx: usize, run: &RunData, al: &Alignment, cfg: &WeakConfig
                 // unwrapped angle (tens of rad) into the result.
                 let theta_dd = k2 / (h_dimless * h_dimless) * (th_i - th_c) * wgt * dtt;
                 target -= theta_dd + kk * (1.0 + ay) * sn;
-                let terms = [
-                    w,
-                    w * w.abs(),
-                    (w * w + cs).abs() * sg,
-                    (w * w + (1.0 + ay) * cs).abs() * sg,
-                    sg,
-                    th_i.sin(),
-                    th_i.cos(),
-                    (2.0 * th_i).sin(),
-                    (2.0 * th_i).cos(),
-                    (3.0 * th_i).sin(),
-                    (3.0 * th_i).cos(),
-                    (4.0 * th_i).sin(),
-                    (4.0 * th_i).cos(),
-                    ay * cs,
-                    -(1.0 + ay) * sn,
-                    (1.0 + ay) * cs,
-                    ay_dot * sn,
-                ];
-                for (xi, v) in x.iter_mut().zip(terms) {
-                    *xi += kk * v;
+                let sample = WeakSample {
+                    theta: th_i,
+                    theta_dot: w,
+                    a_y: ay,
+                    a_y_dot: ay_dot,
+                };
+                for (xi, col) in x.iter_mut().zip(columns()) {
+                    *xi += kk * (col.reg.term)(&sample);
                 }
             }
             let tau_c = a + c as f64 * dt;
@@ -553,10 +558,11 @@ mod tests {
             let rows = weak_rows(0, &run, &al, &cfg);
             assert!(rows.len() > 30, "h = {hw}: {} rows", rows.len());
             // The coefficients are SI: b = β m ω0, μ = M l/r_b, J = j m l².
-            let fit = crate::screen::ols(&rows, &[0, 2, INERTIA]).unwrap();
+            let inertia = mass_column().unwrap();
+            let fit = crate::screen::ols(&rows, &[0, 2, inertia]).unwrap();
             let (b, _) = fit.coef_of(0).unwrap();
             let (mu, _) = fit.coef_of(2).unwrap();
-            let (j, _) = fit.coef_of(INERTIA).unwrap();
+            let (j, _) = fit.coef_of(inertia).unwrap();
             let (b_true, mu_true) = (0.05 * rig.m_kg * w0, 0.007 * rig.l_m / rig.r_b_m);
             assert!(
                 (b / b_true - 1.0).abs() < 0.04,
@@ -712,8 +718,8 @@ mod contrast_tests {
     use super::*;
 
     fn row(run: usize, x_offset: f64, target: f64) -> WeakRow {
-        let mut x = vec![0.0; DELAY + 1];
-        x[OFFSET] = x_offset;
+        let mut x = vec![0.0; columns().len()];
+        x[observation_column().unwrap()] = x_offset;
         WeakRow {
             run,
             tau_s: 0.0,
@@ -745,15 +751,15 @@ mod contrast_tests {
         }
         rows.push(row(3, 1.0, 0.5));
         let cols = add_zero_error_contrasts(&mut rows, &[0, 1, 2]);
-        assert_eq!(cols, vec![DELAY + 1, DELAY + 2]);
-        assert!(rows.last().unwrap().x[DELAY + 1..]
-            .iter()
-            .all(|v| *v == 0.0));
-        let mut all = vec![OFFSET];
+        let n = columns().len();
+        assert_eq!(cols, vec![n, n + 1]);
+        assert!(rows.last().unwrap().x[n..].iter().all(|v| *v == 0.0));
+        let offset = observation_column().unwrap();
+        let mut all = vec![offset];
         all.extend(&cols);
         let fit = crate::screen::ols(&rows[..120], &all).unwrap();
         let mean = offsets.iter().sum::<f64>() / 3.0;
-        let (m, _) = fit.coef_of(OFFSET).unwrap();
+        let (m, _) = fit.coef_of(offset).unwrap();
         assert!((m - mean).abs() < 1e-12, "{m} vs {mean}");
         for (k, th) in offsets[..2].iter().enumerate() {
             let (d, _) = fit.coef_of(cols[k]).unwrap();

@@ -952,15 +952,18 @@ fn envelope_fits<'a>(
 /// A loss term's SI parameter → the run's dimensionless one (the weak form's factors), and its
 /// SI unit.
 fn term_si(t: pendulum_explain::Term, rig: &pendulum_process::RigParams) -> (f64, &'static str) {
-    use pendulum_explain::Term;
-    let f = pendulum_discover::weak::si_factors(rig);
-    match t {
-        Term::ViscousLinear => (f[0], "N·s/m"),
-        Term::ViscousQuadratic => (f[1], "kg/m"),
-        Term::CoulombBearing => (f[2], "1"),
-        Term::CoulombConstant => (f[4], "N·m"),
-        // κ = k/(m g l): a torque per radian, scaled as the torques are.
-        Term::Stiffness => (f[4], "N·m/rad"),
+    use pendulum_discover::weak::{column_of, si_factors};
+    let f = si_factors(rig);
+    match pendulum_model::effects::by_name(t.name()) {
+        Some(e) => (
+            column_of(e.name()).map_or(f64::NAN, |c| f[c]),
+            e.size_unit(),
+        ),
+        // κ = k/(m g l): a torque per radian (no catalogue effect), scaled as the torques are.
+        None => (
+            column_of("coulomb_constant").map_or(f64::NAN, |c| f[c]),
+            "N·m/rad",
+        ),
     }
 }
 

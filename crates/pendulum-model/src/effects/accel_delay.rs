@@ -1,9 +1,18 @@
 //! `accel_delay`: the accelerometer's samples lag the true motion by Δ.
 
-use super::{Draw, Effect, Kind, Param, Sensors, Survey};
+use super::{Draw, Effect, Kind, Param, Regressor, Sensors, Survey};
 
 #[derive(Debug)]
 pub struct AccelDelay;
+
+/// Discover's column: A_y' sin θ, the equation error's first-order change with the
+/// accelerometer's lag (Δ ω0 in dimensionless time).
+static REGRESSORS: [Regressor; 1] = [Regressor {
+    name: "delay",
+    group: 0,
+    term: |s| s.a_y_dot * s.theta.sin(),
+    per_si: |p| p.omega0_rad_s(),
+}];
 
 static PARAMS: [Param; 1] = [Param::real("accel_delay.Delta", "s", "s", (-0.05, 0.05))];
 
@@ -13,6 +22,9 @@ impl Effect for AccelDelay {
     }
     fn kind(&self) -> Kind {
         Kind::Input
+    }
+    fn regressors(&self) -> &'static [Regressor] {
+        &REGRESSORS
     }
     fn params(&self) -> &'static [Param] {
         &PARAMS

@@ -1,10 +1,19 @@
 //! `bearing_load_base_accel`: the bearing load also carries the base's acceleration.
 
-use super::{Decompiled, Draw, Effect, Kind, Param, Survey};
+use super::{Decompiled, Draw, Effect, Kind, Param, Regressor, Survey};
 use crate::{Dimensionless, Physical};
 
 #[derive(Debug)]
 pub struct BearingLoadBaseAccel;
+
+/// Discover's column: the bearing load with the base's acceleration,
+/// |θ'² + (1 + A_y) cos θ| sgn θ' (M = μ r_b/l), in place of coulomb_bearing's.
+static REGRESSORS: [Regressor; 1] = [Regressor {
+    name: "coul_base",
+    group: 0,
+    term: |s| (s.theta_dot * s.theta_dot + (1.0 + s.a_y) * s.theta.cos()).abs() * s.sgn(),
+    per_si: |p| p.r_b_m / p.l_m,
+}];
 
 impl Effect for BearingLoadBaseAccel {
     fn positive(&self) -> bool {
@@ -18,6 +27,15 @@ impl Effect for BearingLoadBaseAccel {
     }
     fn kind(&self) -> Kind {
         Kind::Dynamics
+    }
+    fn regressors(&self) -> &'static [Regressor] {
+        &REGRESSORS
+    }
+    fn size_key(&self) -> Option<&'static str> {
+        Some("mu")
+    }
+    fn replaces(&self) -> Option<&'static str> {
+        Some("coulomb_bearing")
     }
     fn params(&self) -> &'static [Param] {
         &[]

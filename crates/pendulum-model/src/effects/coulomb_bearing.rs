@@ -1,10 +1,19 @@
 //! `coulomb_bearing`: the reference model's load-proportional dry friction μ r_b F_N sgn θ'.
 
-use super::{Decompiled, Draw, Effect, Kind, Param, Survey};
+use super::{Decompiled, Draw, Effect, Kind, Param, Regressor, Survey};
 use crate::{Dimensionless, Physical};
 
 #[derive(Debug)]
 pub struct CoulombBearing;
+
+/// Discover's column: the bearing load without the base's acceleration, |θ'² + cos θ| sgn θ'
+/// (M = μ r_b/l).
+static REGRESSORS: [Regressor; 1] = [Regressor {
+    name: "coul_ref",
+    group: 0,
+    term: |s| (s.theta_dot * s.theta_dot + s.theta.cos()).abs() * s.sgn(),
+    per_si: |p| p.r_b_m / p.l_m,
+}];
 
 static PARAMS: [Param; 1] = [Param::real("mu", "mu", "1", (0.0, 0.25))];
 
@@ -20,6 +29,9 @@ impl Effect for CoulombBearing {
     }
     fn kind(&self) -> Kind {
         Kind::Dynamics
+    }
+    fn regressors(&self) -> &'static [Regressor] {
+        &REGRESSORS
     }
     fn params(&self) -> &'static [Param] {
         &PARAMS

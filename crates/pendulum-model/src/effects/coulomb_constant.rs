@@ -1,10 +1,18 @@
 //! `coulomb_constant`: a load-independent dry torque T_c sgn θ' (seals, a belt-coupled motor).
 
-use super::{Decompiled, Draw, Effect, Kind, Param, Survey};
+use super::{Decompiled, Draw, Effect, Kind, Param, Regressor, Survey};
 use crate::{Dimensionless, Physical};
 
 #[derive(Debug)]
 pub struct CoulombConstant;
+
+/// Discover's column: sgn θ' (c = T_c/(m g l)).
+static REGRESSORS: [Regressor; 1] = [Regressor {
+    name: "const",
+    group: 0,
+    term: |s| s.sgn(),
+    per_si: |p| 1.0 / (p.m_kg * p.g_m_s2 * p.l_m),
+}];
 
 static PARAMS: [Param; 1] = [Param::real(
     "coulomb_constant.T_c",
@@ -25,6 +33,9 @@ impl Effect for CoulombConstant {
     }
     fn kind(&self) -> Kind {
         Kind::Dynamics
+    }
+    fn regressors(&self) -> &'static [Regressor] {
+        &REGRESSORS
     }
     fn params(&self) -> &'static [Param] {
         &PARAMS

@@ -1,9 +1,18 @@
 //! `encoder_offset`: the count was zeroed away from the hanging position.
 
-use super::{Draw, Effect, Kind, Param, Sensors, Survey};
+use super::{Draw, Effect, Kind, Param, Regressor, Sensors, Survey};
 
 #[derive(Debug)]
 pub struct EncoderOffset;
+
+/// Discover's column: (1 + A_y) cos θ, the equation error's first-order change with the
+/// reading's offset (its coefficient is −θ_off).
+static REGRESSORS: [Regressor; 1] = [Regressor {
+    name: "offset",
+    group: 0,
+    term: |s| (1.0 + s.a_y) * s.theta.cos(),
+    per_si: |_| 1.0,
+}];
 
 static PARAMS: [Param; 1] = [Param::real(
     "encoder_offset.theta_off",
@@ -18,6 +27,14 @@ impl Effect for EncoderOffset {
     }
     fn kind(&self) -> Kind {
         Kind::Observation
+    }
+    fn regressors(&self) -> &'static [Regressor] {
+        &REGRESSORS
+    }
+    /// θ_off = −(the coefficient).
+    fn estimate(&self, coef: &[(f64, f64)]) -> (f64, f64) {
+        let (v, e) = coef[0];
+        (-v, e)
     }
     fn params(&self) -> &'static [Param] {
         &PARAMS

@@ -1,10 +1,19 @@
 //! `extra_inertia`: rotating inertia J besides the bob (rod, shaft, coupled rotor).
 
-use super::{Decompiled, Draw, Effect, Kind, Param, Survey};
+use super::{Decompiled, Draw, Effect, Kind, Param, Regressor, Survey};
 use crate::{Dimensionless, Physical};
 
 #[derive(Debug)]
 pub struct ExtraInertia;
+
+/// Discover's column: −(1 + A_y) sin θ, the model's θ'' standing in for the measured one (free
+/// of its noise), j = J/(m l²).
+static REGRESSORS: [Regressor; 1] = [Regressor {
+    name: "inertia",
+    group: 0,
+    term: |s| -(1.0 + s.a_y) * s.theta.sin(),
+    per_si: |p| 1.0 / (p.m_kg * p.l_m * p.l_m),
+}];
 
 static PARAMS: [Param; 1] = [Param::real(
     "extra_inertia.J",
@@ -22,6 +31,9 @@ impl Effect for ExtraInertia {
     }
     fn kind(&self) -> Kind {
         Kind::Mass
+    }
+    fn regressors(&self) -> &'static [Regressor] {
+        &REGRESSORS
     }
     fn params(&self) -> &'static [Param] {
         &PARAMS

@@ -1,10 +1,18 @@
 //! `horizontal_base`: the shaker's guide is tilted δ, so the axis also moves horizontally.
 
-use super::{Decompiled, Draw, Effect, Kind, Param, Survey};
+use super::{Decompiled, Draw, Effect, Kind, Param, Regressor, Survey};
 use crate::{Dimensionless, Physical};
 
 #[derive(Debug)]
 pub struct HorizontalBase;
+
+/// Discover's column: A_y cos θ (tan δ).
+static REGRESSORS: [Regressor; 1] = [Regressor {
+    name: "horiz",
+    group: 0,
+    term: |s| s.a_y * s.theta.cos(),
+    per_si: |_| 1.0,
+}];
 
 static PARAMS: [Param; 1] = [Param::real(
     "horizontal_base.delta",
@@ -19,6 +27,14 @@ impl Effect for HorizontalBase {
     }
     fn kind(&self) -> Kind {
         Kind::Dynamics
+    }
+    fn regressors(&self) -> &'static [Regressor] {
+        &REGRESSORS
+    }
+    /// δ = atan of the coefficient tan δ.
+    fn estimate(&self, coef: &[(f64, f64)]) -> (f64, f64) {
+        let (v, e) = coef[0];
+        (v.atan(), e / (1.0 + v * v))
     }
     fn params(&self) -> &'static [Param] {
         &PARAMS

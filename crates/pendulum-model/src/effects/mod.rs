@@ -162,6 +162,52 @@ pub struct RateShape {
     pub f: fn(f64, f64) -> f64,
 }
 
+/// One sample of the measured motion as a weak-form regressor sees it, in the run's
+/// dimensionless units (time in 1/ω0, so θ' in units of ω0; accelerations in g).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WeakSample {
+    /// θ, rad (unwrapped).
+    pub theta: f64,
+    /// θ', dimensionless.
+    pub theta_dot: f64,
+    /// The base's vertical acceleration A_y, in g (0 in a free segment).
+    pub a_y: f64,
+    /// Its rate dA_y/dτ (dimensionless time).
+    pub a_y_dot: f64,
+}
+
+impl WeakSample {
+    /// sgn θ' (0 at exactly 0).
+    pub fn sgn(&self) -> f64 {
+        if self.theta_dot > 0.0 {
+            1.0
+        } else if self.theta_dot < 0.0 {
+            -1.0
+        } else {
+            0.0
+        }
+    }
+}
+
+/// A column of discover's weak-form equation error: the effect's term of the dimensionless
+/// equation θ'' = … per unit of its dimensionless coefficient, evaluated at each sample and
+/// integrated against the test function, times the run's factor from the SI parameter to that
+/// coefficient, so that the regression's coefficient is the SI parameter (the same for every run
+/// of a campaign that mixes bobs and cranks). An observation or input effect's column is its
+/// first-order change of the equation error (the encoder offset, the accelerometer's lag).
+#[derive(Debug, Clone, Copy)]
+pub struct Regressor {
+    /// A short name for tables and messages.
+    pub name: &'static str,
+    /// The candidate it belongs to: columns sharing a group enter the regression together
+    /// (position_torque's harmonic k: sin kθ and cos kθ); 0 for an effect with one candidate.
+    pub group: u32,
+    /// The term at one sample.
+    pub term: fn(&WeakSample) -> f64,
+    /// Dimensionless coefficient per unit of the SI parameter, for a run's m, l, r_b, g.
+    pub per_si: fn(&Physical) -> f64,
+}
+
 /// What [`Effect::decompile`] finds in the coefficients.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Decompiled {
@@ -240,6 +286,49 @@ pub trait Effect: Sync + std::fmt::Debug {
     /// A torque following θ' through a speed scale (see [`RateShape`]).
     fn rate_shape(&self) -> Option<&'static RateShape> {
         None
+    }
+
+    /// Its columns in discover's weak-form equation error (see [`Regressor`]); none: not
+    /// discovered by regression (a shaped torque gets its column from [`Effect::rate_shape`]).
+    fn regressors(&self) -> &'static [Regressor] {
+        &[]
+    }
+
+    /// The SI estimate and standard error of its size (the first parameter, or what
+    /// [`Effect::size_key`] names) from its group's regression coefficients `(value, se)`, in
+    /// [`Effect::regressors`]' order. Default: the one coefficient itself.
+    fn estimate(&self, coef: &[(f64, f64)]) -> (f64, f64) {
+        coef.first().copied().unwrap_or((f64::NAN, f64::NAN))
+    }
+
+    /// The parameter its size is judged by: its first, or (a switch without parameters, such as
+    /// bearing_load_base_accel) the reference parameter it changes.
+    fn size_key(&self) -> Option<&'static str> {
+        self.params().first().map(|p| p.key)
+    }
+
+    /// The SI unit of its size.
+    fn size_unit(&self) -> &'static str {
+        self.params().first().map_or("1", |p| p.unit)
+    }
+
+    /// A reference-model term whose column this effect's replaces in the regression
+    /// (bearing_load_base_accel: the bearing load with the base's acceleration in it). Offered
+    /// only where the model in hand has that term.
+    fn replaces(&self) -> Option<&'static str> {
+        None
+    }
+
+    /// The start of its refit from the screen, in [`Effect::params`]' order: given the size
+    /// (already inside its range), its group's coefficients and the group. Default: the size,
+    /// then each further parameter's `unset` value.
+    fn refit_start(&self, size: f64, coef: &[f64], group: u32) -> Vec<f64> {
+        let _ = (coef, group);
+        let mut values: Vec<f64> = self.params().iter().map(|p| p.unset).collect();
+        if let Some(v) = values.first_mut() {
+            *v = size;
+        }
+        values
     }
 }
 

@@ -1,10 +1,65 @@
 //! `position_torque`: a torque of the angle alone, T_p sin(kθ + φ_p) (cogging, bob imbalance).
 
-use super::{Decompiled, Draw, Effect, Kind, Param, Survey};
+use super::{Decompiled, Draw, Effect, Kind, Param, Regressor, Survey};
 use crate::{Dimensionless, Physical};
 
 #[derive(Debug)]
 pub struct PositionTorque;
+
+/// Discover's columns: sin kθ and cos kθ for k = 1…4, one candidate per k
+/// (p = T_p/(m g l)).
+static REGRESSORS: [Regressor; 8] = [
+    Regressor {
+        name: "pos1_sin",
+        group: 1,
+        term: |s| s.theta.sin(),
+        per_si: TORQUE,
+    },
+    Regressor {
+        name: "pos1_cos",
+        group: 1,
+        term: |s| s.theta.cos(),
+        per_si: TORQUE,
+    },
+    Regressor {
+        name: "pos2_sin",
+        group: 2,
+        term: |s| (2.0 * s.theta).sin(),
+        per_si: TORQUE,
+    },
+    Regressor {
+        name: "pos2_cos",
+        group: 2,
+        term: |s| (2.0 * s.theta).cos(),
+        per_si: TORQUE,
+    },
+    Regressor {
+        name: "pos3_sin",
+        group: 3,
+        term: |s| (3.0 * s.theta).sin(),
+        per_si: TORQUE,
+    },
+    Regressor {
+        name: "pos3_cos",
+        group: 3,
+        term: |s| (3.0 * s.theta).cos(),
+        per_si: TORQUE,
+    },
+    Regressor {
+        name: "pos4_sin",
+        group: 4,
+        term: |s| (4.0 * s.theta).sin(),
+        per_si: TORQUE,
+    },
+    Regressor {
+        name: "pos4_cos",
+        group: 4,
+        term: |s| (4.0 * s.theta).cos(),
+        per_si: TORQUE,
+    },
+];
+
+const TORQUE: fn(&Physical) -> f64 = |p| 1.0 / (p.m_kg * p.g_m_s2 * p.l_m);
 
 static PARAMS: [Param; 3] = [
     Param::real("position_torque.T_p", "t_p_nm", "N·m", (0.0, 0.1)),
@@ -31,6 +86,21 @@ impl Effect for PositionTorque {
     }
     fn kind(&self) -> Kind {
         Kind::Dynamics
+    }
+    fn regressors(&self) -> &'static [Regressor] {
+        &REGRESSORS
+    }
+    /// T_p = √(a² + b²) of T_p sin(kθ + φ_p) = a sin kθ + b cos kθ.
+    fn estimate(&self, coef: &[(f64, f64)]) -> (f64, f64) {
+        let (a, ea) = coef[0];
+        let (b, eb) = coef[1];
+        let p = a.hypot(b);
+        let se = ((a * ea).powi(2) + (b * eb).powi(2)).sqrt() / p.max(1e-300);
+        (p, se)
+    }
+    /// T_p, the candidate's k (not refitted) and φ_p = atan2(b, a).
+    fn refit_start(&self, size: f64, coef: &[f64], group: u32) -> Vec<f64> {
+        vec![size, group as f64, coef[1].atan2(coef[0])]
     }
     fn params(&self) -> &'static [Param] {
         &PARAMS

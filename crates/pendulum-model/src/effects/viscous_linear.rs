@@ -1,10 +1,18 @@
 //! `viscous_linear`: the reference model's linear drag b l² θ'.
 
-use super::{Decompiled, Draw, Effect, Kind, Param, Survey};
+use super::{Decompiled, Draw, Effect, Kind, Param, Regressor, Survey};
 use crate::{Dimensionless, Physical};
 
 #[derive(Debug)]
 pub struct ViscousLinear;
+
+/// Discover's column: θ' (β = b/(m ω0)).
+static REGRESSORS: [Regressor; 1] = [Regressor {
+    name: "lin",
+    group: 0,
+    term: |s| s.theta_dot,
+    per_si: |p| 1.0 / (p.m_kg * p.omega0_rad_s()),
+}];
 
 static PARAMS: [Param; 1] = [Param::real("b", "b_n_s_m", "N·s/m", (0.0, 1.0))];
 
@@ -17,6 +25,9 @@ impl Effect for ViscousLinear {
     }
     fn kind(&self) -> Kind {
         Kind::Dynamics
+    }
+    fn regressors(&self) -> &'static [Regressor] {
+        &REGRESSORS
     }
     fn params(&self) -> &'static [Param] {
         &PARAMS

@@ -1,10 +1,18 @@
 //! `viscous_quadratic`: the reference model's quadratic drag a l³ θ'|θ'|.
 
-use super::{Decompiled, Draw, Effect, Kind, Param, Survey};
+use super::{Decompiled, Draw, Effect, Kind, Param, Regressor, Survey};
 use crate::{Dimensionless, Physical};
 
 #[derive(Debug)]
 pub struct ViscousQuadratic;
+
+/// Discover's column: θ'|θ'| (α = a l/m).
+static REGRESSORS: [Regressor; 1] = [Regressor {
+    name: "quad",
+    group: 0,
+    term: |s| s.theta_dot * s.theta_dot.abs(),
+    per_si: |p| p.l_m / p.m_kg,
+}];
 
 static PARAMS: [Param; 1] = [Param::real("a", "a_kg_m", "kg/m", (0.0, 1.0))];
 
@@ -17,6 +25,9 @@ impl Effect for ViscousQuadratic {
     }
     fn kind(&self) -> Kind {
         Kind::Dynamics
+    }
+    fn regressors(&self) -> &'static [Regressor] {
+        &REGRESSORS
     }
     fn params(&self) -> &'static [Param] {
         &PARAMS
