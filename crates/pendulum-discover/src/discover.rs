@@ -345,36 +345,19 @@ fn to_si(c: &Candidate, fit: &crate::screen::Ols) -> (f64, f64, &'static str) {
     (v, se, e.size_unit())
 }
 
-/// Effects whose size is within the rig's normal tolerances are not named: the encoder is zeroed
-/// by hand to within a few counts (rig.md), so an offset under 4 counts (6 mrad) is not the effect
-/// `encoder_offset`; the firmware stamps each sample to within the jitter rig.md states ("tens of
-/// µs"), so a lag within two standard deviations of one accelerometer stamp's timing error
-/// (`stamp_jitter_s`, measured on the campaign) is the stamps' own accuracy, not the effect
-/// `accel_delay`. (A low-pass filter whose delay is compensated for its DC group delay leaves a
-/// few tens of µs on the crank's harmonics; real lags are milliseconds.)
-///
-/// An extra inertia under [`INERTIA_FLOOR_REL`] of the lightest run's m l² is within what the
-/// point-mass model itself leaves out (the bob's own moment about its centre, the rod's and
-/// shaft's), not the effect `extra_inertia`: a 1.2e-5 kg·m² "inertia" (0.02 % of m l²) rode
-/// along with hidden quadratic drag on a drawn design, accepted on an equation-error gain of 8 %.
+/// Effects whose size is within the rig's normal tolerances are not named (the catalogue's
+/// [`pendulum_model::Tolerance`]: the encoder's hand zeroing, the stamps' timing jitter
+/// measured on the campaign, the inertia the point-mass bob leaves out).
 fn practically_significant(
     effect: &str,
     estimate: f64,
     stamp_jitter_s: f64,
     bob_inertia_kg_m2: f64,
 ) -> bool {
-    match effect {
-        "encoder_offset" => estimate.abs() > crate::screen::ENCODER_OFFSET_FLOOR_RAD,
-        "accel_delay" => !(estimate.abs() <= 2.0 * stamp_jitter_s),
-        "extra_inertia" => !(estimate.abs() <= INERTIA_FLOOR_REL * bob_inertia_kg_m2),
-        _ => true,
-    }
+    pendulum_model::effects::by_name(effect)
+        .and_then(|e| e.tolerance())
+        .is_none_or(|t| !(estimate.abs() <= t.bound(stamp_jitter_s, bob_inertia_kg_m2)))
 }
-
-/// Fraction of a bob's m l² below which an extra inertia is not named (see
-/// [`practically_significant`]): a 2 cm bob's own moment is (2/5)(r/l)² ≈ 0.4 % of m l² at
-/// l = 0.2 m, a rod's and shaft's of the same order.
-pub const INERTIA_FLOOR_REL: f64 = 0.01;
 
 /// The smallest m l² over the campaign's runs with a known bob, kg·m² (NaN if none).
 fn lightest_bob_inertia_kg_m2(ctx: &Context) -> f64 {
@@ -409,18 +392,12 @@ fn stamp_jitter_s(ctx: &Context) -> f64 {
     1.4826 * dev[dev.len() / 2] / std::f64::consts::SQRT_2
 }
 
-/// Whether an estimate is in its effect's physical range: every dissipative term (b, a, μ, the
-/// bearing load's μ, T_c) takes energy out, so it cannot be negative (a negative dry torque
-/// feeds energy in), and an inertia cannot be negative. Outside it the screen has found a
-/// departure that the effect does not describe.
+/// Whether an estimate is in its effect's physical range ([`pendulum_model::Effect::possible`]):
+/// every dissipative term (b, a, μ, the bearing load's μ, T_c) takes energy out, so it cannot be
+/// negative (a negative dry torque feeds energy in), and an inertia cannot be negative. Outside
+/// it the screen has found a departure that the effect does not describe.
 pub fn physically_possible(effect: &str, estimate: f64) -> bool {
-    match effect {
-        "encoder_offset" => estimate.abs() < std::f64::consts::PI,
-        _ if pendulum_model::effects::by_name(effect).is_some_and(|e| e.positive()) => {
-            estimate > 0.0
-        }
-        _ => estimate.is_finite(),
-    }
+    pendulum_model::effects::by_name(effect).map_or(estimate.is_finite(), |e| e.possible(estimate))
 }
 
 /// Relative accuracy the product promises for an estimate; the two views of an effect must agree

@@ -9,8 +9,8 @@
 use serde::{Deserialize, Serialize};
 
 use crate::weak::{
-    column_of, group_columns, is_dynamics, mass_column, observation_column, set_shape, shaped,
-    shaped_columns, WeakRow,
+    column_of, columns, group_columns, is_dynamics, mass_column, observation_column, set_shape,
+    shaped, shaped_columns, WeakRow,
 };
 
 /// The base models discover starts from.
@@ -477,19 +477,22 @@ pub fn screen(rows: &[WeakRow], current: &[usize], cands: &[Candidate]) -> Vec<S
     out
 }
 
-/// The encoder is zeroed by hand to within a few counts (rig.md): an offset under 4 counts
-/// (6.1 mrad) is the rig's normal zeroing error, not the effect `encoder_offset`.
-pub const ENCODER_OFFSET_FLOOR_RAD: f64 = 4.0 * 2.0 * std::f64::consts::PI / 4096.0;
-
 /// Whether a screened candidate is a normal tolerance of the rig rather than an effect: then it
 /// is kept in the regression as a nuisance term (so that its torque, e.g. a one-count zero error's
-/// m g l θ_off cos θ, is not mistaken for a position torque) but never named.
+/// m g l θ_off cos θ, is not mistaken for a position torque) but never named. Only the encoder's
+/// reading offset (the catalogue's observation effect) is such a term: its tolerance (a few
+/// counts of hand zeroing) needs nothing measured on the campaign.
 pub fn is_nuisance(s: &Screened) -> bool {
-    let offset = observation_column();
-    offset.is_some_and(|c| s.candidate.add == [c])
+    let Some(col) = observation_column() else {
+        return false;
+    };
+    let Some(tol) = columns()[col].effect.tolerance() else {
+        return false;
+    };
+    s.candidate.add == [col]
         && s.fit
-            .coef_of(offset.unwrap_or(usize::MAX))
-            .is_some_and(|(v, _)| v.abs() <= ENCODER_OFFSET_FLOOR_RAD)
+            .coef_of(col)
+            .is_some_and(|(v, _)| v.abs() <= tol.bound(f64::NAN, f64::NAN))
 }
 
 /// Result of the forward stepwise screen.
@@ -598,7 +601,7 @@ mod tests {
         for (r, bob) in bobs.iter().enumerate() {
             for i in 0..200 {
                 let u = (i * 13 + r * 7) as f64;
-                let mut x = vec![0.0; crate::weak::columns().len()];
+                let mut x = vec![0.0; columns().len()];
                 x[lin] = (u * 0.37).sin() * 3.0;
                 x[dry] = (u * 0.11).cos().signum() / (1.3 - 0.6 * r as f64);
                 x[inertia] = (u * 0.23).sin() / bob;

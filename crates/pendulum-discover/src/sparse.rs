@@ -15,32 +15,9 @@
 
 use crate::weak::WeakRow;
 
-/// The variable a library term follows (effects.md's list).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
-pub enum Variable {
-    /// θ̇.
-    Rate,
-    /// θ, unwrapped (not periodic in a turn).
-    Angle,
-    /// θ modulo 2π.
-    AngleInTurn,
-    /// The forcing (crank) phase.
-    Phase,
-    /// Time along the run.
-    Time,
-}
-
-impl Variable {
-    pub fn label(self) -> &'static str {
-        match self {
-            Variable::Rate => "dθ/dt",
-            Variable::Angle => "θ (unwrapped)",
-            Variable::AngleInTurn => "θ (mod 2π)",
-            Variable::Phase => "forcing phase",
-            Variable::Time => "time",
-        }
-    }
-}
+/// The variable a library term follows (effects.md's list): the catalogue's, so that an
+/// effect says which it follows ([`pendulum_model::Effect::follows`]).
+pub use pendulum_model::Variable;
 
 /// One library term: its name (with its unit's power), the variable it follows and the shape it
 /// stands for.
@@ -449,15 +426,9 @@ pub fn describe(
 /// The variables a catalogue effect's torque follows, when its regressor is a function of them
 /// alone (so that the library can describe the same departure in that variable with a freer
 /// shape); empty for effects that couple to the forcing or the sensors (their regressors carry
-/// the measured acceleration, which the library does not).
+/// the measured acceleration, which the library does not). From [`pendulum_model::Effect::follows`].
 pub fn family_of(effect: &str) -> &'static [Variable] {
-    match effect {
-        "viscous_linear" | "viscous_quadratic" | "coulomb_constant" => &[Variable::Rate],
-        // A torque shaped by a speed scale follows θ̇ too.
-        _ if crate::weak::shaped_column(effect).is_some() => &[Variable::Rate],
-        "position_torque" | "extra_inertia" => &[Variable::Angle, Variable::AngleInTurn],
-        _ => &[],
-    }
+    pendulum_model::effects::by_name(effect).map_or(&[], |e| e.follows())
 }
 
 /// ΔBIC a freer description in the candidate's own variable must reach over the candidate for

@@ -12,7 +12,9 @@ pub mod steady;
 #[cfg(test)]
 mod physics_tests;
 
-pub use effects::{Effect, EffectParam, RateShape, Regressor, Sensors, WeakSample, CATALOGUE};
+pub use effects::{
+    Effect, EffectParam, RateShape, Regressor, Sensors, Tolerance, Variable, WeakSample, CATALOGUE,
+};
 pub use excitation::{CrankDrive, CrankTable, Excitation, MeasuredAccel};
 pub use params::{Dimensionless, Effects, Physical};
 pub use power::{mean_powers, MeanPowers};

@@ -1,6 +1,6 @@
 //! `accel_delay`: the accelerometer's samples lag the true motion by Δ.
 
-use super::{Draw, Effect, Kind, Param, Regressor, Sensors, Survey};
+use super::{Draw, Effect, Kind, Param, Regressor, Sensors, Survey, Tolerance};
 
 #[derive(Debug)]
 pub struct AccelDelay;
@@ -22,6 +22,13 @@ impl Effect for AccelDelay {
     }
     fn kind(&self) -> Kind {
         Kind::Input
+    }
+    /// Within two standard deviations of one stamp's timing jitter: the firmware stamps each
+    /// sample to within "tens of µs" (rig.md), and a low-pass filter whose delay is compensated
+    /// for its DC group delay leaves a few tens of µs on the crank's harmonics; real lags are
+    /// milliseconds.
+    fn tolerance(&self) -> Option<Tolerance> {
+        Some(Tolerance::StampJitter(2.0))
     }
     fn regressors(&self) -> &'static [Regressor] {
         &REGRESSORS

@@ -1,6 +1,6 @@
 //! `coulomb_constant`: a load-independent dry torque T_c sgn θ' (seals, a belt-coupled motor).
 
-use super::{Decompiled, Draw, Effect, Kind, Param, Regressor, Survey};
+use super::{Decompiled, Draw, Effect, Kind, Param, Regressor, Survey, Variable};
 use crate::{Dimensionless, Physical};
 
 #[derive(Debug)]
@@ -33,6 +33,9 @@ impl Effect for CoulombConstant {
     }
     fn kind(&self) -> Kind {
         Kind::Dynamics
+    }
+    fn follows(&self) -> &'static [Variable] {
+        &[Variable::Rate]
     }
     fn regressors(&self) -> &'static [Regressor] {
         &REGRESSORS

@@ -1,6 +1,6 @@
 //! `encoder_offset`: the count was zeroed away from the hanging position.
 
-use super::{Draw, Effect, Kind, Param, Regressor, Sensors, Survey};
+use super::{Draw, Effect, Kind, Param, Regressor, Sensors, Survey, Tolerance};
 
 #[derive(Debug)]
 pub struct EncoderOffset;
@@ -27,6 +27,14 @@ impl Effect for EncoderOffset {
     }
     fn kind(&self) -> Kind {
         Kind::Observation
+    }
+    /// Under 4 counts (6.1 mrad at 4096 per turn): the rig's normal zeroing error.
+    fn tolerance(&self) -> Option<Tolerance> {
+        Some(Tolerance::EncoderCounts(4.0))
+    }
+    /// Within half a turn: an offset beyond it is another zero, not an offset.
+    fn possible(&self, size: f64) -> bool {
+        size.abs() < std::f64::consts::PI
     }
     fn regressors(&self) -> &'static [Regressor] {
         &REGRESSORS

@@ -208,6 +208,61 @@ pub struct Regressor {
     pub per_si: fn(&Physical) -> f64,
 }
 
+/// A variable a torque can follow (effects.md's list for `unexplained`): discover's generic
+/// library describes departures in these, and an effect whose regressor is a function of some of
+/// them alone says so ([`Effect::follows`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Variable {
+    /// θ̇.
+    Rate,
+    /// θ, unwrapped (not periodic in a turn).
+    Angle,
+    /// θ modulo 2π.
+    AngleInTurn,
+    /// The forcing (crank) phase.
+    Phase,
+    /// Time along the run.
+    Time,
+}
+
+impl Variable {
+    pub fn label(self) -> &'static str {
+        match self {
+            Variable::Rate => "dθ/dt",
+            Variable::Angle => "θ (unwrapped)",
+            Variable::AngleInTurn => "θ (mod 2π)",
+            Variable::Phase => "forcing phase",
+            Variable::Time => "time",
+        }
+    }
+}
+
+/// A size within the rig's normal tolerances (rig.md), below which discover does not name the
+/// effect: the rig itself, not a departure.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Tolerance {
+    /// |size| ≤ this many encoder counts at 4096 per turn (rad): the count is zeroed by hand to
+    /// within a few counts at every power-on.
+    EncoderCounts(f64),
+    /// |size| ≤ this many standard deviations of one accelerometer stamp's timing error (s, as
+    /// measured on the campaign): the stamps' own accuracy.
+    StampJitter(f64),
+    /// |size| ≤ this fraction of the lightest run's m l² (kg·m²): what the point-mass model
+    /// itself leaves out (the bob's own moment about its centre, the rod's and the shaft's).
+    BobInertia(f64),
+}
+
+impl Tolerance {
+    /// The bound, given the campaign's stamp jitter (s) and lightest bob inertia (kg·m²).
+    pub fn bound(self, stamp_jitter_s: f64, bob_inertia_kg_m2: f64) -> f64 {
+        match self {
+            Tolerance::EncoderCounts(n) => n * 2.0 * std::f64::consts::PI / 4096.0,
+            Tolerance::StampJitter(k) => k * stamp_jitter_s,
+            Tolerance::BobInertia(f) => f * bob_inertia_kg_m2,
+        }
+    }
+}
+
 /// What [`Effect::decompile`] finds in the coefficients.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Decompiled {
@@ -305,6 +360,33 @@ pub trait Effect: Sync + std::fmt::Debug {
     /// bearing_load_base_accel) the reference parameter it changes.
     fn size_key(&self) -> Option<&'static str> {
         self.params().first().map(|p| p.key)
+    }
+
+    /// Whether `size` is in its physical range (default: a [`Effect::positive`] size must be
+    /// > 0; any other finite). Outside it, discover has found a departure the effect does not
+    /// describe.
+    fn possible(&self, size: f64) -> bool {
+        if self.positive() {
+            size > 0.0
+        } else {
+            size.is_finite()
+        }
+    }
+
+    /// The rig's own tolerance on its size, if any (see [`Tolerance`]).
+    fn tolerance(&self) -> Option<Tolerance> {
+        None
+    }
+
+    /// The variables its torque follows when its regressor is a function of them alone (so that
+    /// discover's generic library can describe the same departure in them with a freer shape);
+    /// empty for effects coupled to the forcing or the sensors. Default: θ̇ for a shaped torque.
+    fn follows(&self) -> &'static [Variable] {
+        if self.rate_shape().is_some() {
+            &[Variable::Rate]
+        } else {
+            &[]
+        }
     }
 
     /// The SI unit of its size.

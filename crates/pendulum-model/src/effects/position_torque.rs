@@ -1,6 +1,6 @@
 //! `position_torque`: a torque of the angle alone, T_p sin(kθ + φ_p) (cogging, bob imbalance).
 
-use super::{Decompiled, Draw, Effect, Kind, Param, Regressor, Survey};
+use super::{Decompiled, Draw, Effect, Kind, Param, Regressor, Survey, Variable};
 use crate::{Dimensionless, Physical};
 
 #[derive(Debug)]
@@ -86,6 +86,9 @@ impl Effect for PositionTorque {
     }
     fn kind(&self) -> Kind {
         Kind::Dynamics
+    }
+    fn follows(&self) -> &'static [Variable] {
+        &[Variable::Angle, Variable::AngleInTurn]
     }
     fn regressors(&self) -> &'static [Regressor] {
         &REGRESSORS

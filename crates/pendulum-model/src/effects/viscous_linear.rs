@@ -1,6 +1,6 @@
 //! `viscous_linear`: the reference model's linear drag b l² θ'.
 
-use super::{Decompiled, Draw, Effect, Kind, Param, Regressor, Survey};
+use super::{Decompiled, Draw, Effect, Kind, Param, Regressor, Survey, Variable};
 use crate::{Dimensionless, Physical};
 
 #[derive(Debug)]
@@ -25,6 +25,9 @@ impl Effect for ViscousLinear {
     }
     fn kind(&self) -> Kind {
         Kind::Dynamics
+    }
+    fn follows(&self) -> &'static [Variable] {
+        &[Variable::Rate]
     }
     fn regressors(&self) -> &'static [Regressor] {
         &REGRESSORS

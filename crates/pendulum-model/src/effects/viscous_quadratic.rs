@@ -1,6 +1,6 @@
 //! `viscous_quadratic`: the reference model's quadratic drag a l³ θ'|θ'|.
 
-use super::{Decompiled, Draw, Effect, Kind, Param, Regressor, Survey};
+use super::{Decompiled, Draw, Effect, Kind, Param, Regressor, Survey, Variable};
 use crate::{Dimensionless, Physical};
 
 #[derive(Debug)]
@@ -25,6 +25,9 @@ impl Effect for ViscousQuadratic {
     }
     fn kind(&self) -> Kind {
         Kind::Dynamics
+    }
+    fn follows(&self) -> &'static [Variable] {
+        &[Variable::Rate]
     }
     fn regressors(&self) -> &'static [Regressor] {
         &REGRESSORS
