@@ -363,8 +363,8 @@ pub trait Effect: Sync + std::fmt::Debug {
     }
 
     /// Whether `size` is in its physical range (default: a [`Effect::positive`] size must be
-    /// > 0; any other finite). Outside it, discover has found a departure the effect does not
-    /// describe.
+    /// above 0; any other finite). Outside it, discover has found a departure the effect does
+    /// not describe.
     fn possible(&self, size: f64) -> bool {
         if self.positive() {
             size > 0.0
