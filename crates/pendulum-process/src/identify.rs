@@ -895,6 +895,59 @@ impl RunEnvelope {
         let tol = ENVELOPE_TOLERANCE * est.abs();
         Some(((lo - tol).max(0.0), hi + tol))
     }
+
+    /// How much term `t` of `part` loses per cycle over this envelope's swings, per unit of its
+    /// parameter, relative to the envelope's own term(s) of the part (their estimate-weighted
+    /// loss curve): 1 for the viscous and quadratic parts (one term each) and for a dry term
+    /// the envelope kept itself. The two dry terms differ at large swings (the bearing load
+    /// |θ'² + cos θ| of M exceeds 1: M loses 1.6× what c does at 1.3 rad), so a fit's M is
+    /// compared with an envelope's coulomb_constant as the c that loses as much over the same
+    /// swings (MultiArm's large decay over 40 s: M = 1.83e-3 is c = 2.4e-3 there, inside the
+    /// envelope's [2.11e-3, 2.67e-3], not below it).
+    fn ratio(&self, part: LawPart, t: pendulum_explain::Term) -> f64 {
+        let kept: Vec<(pendulum_explain::Term, f64)> = self
+            .env
+            .catalogue
+            .iter()
+            .filter_map(|c| {
+                DECAY_TERMS
+                    .iter()
+                    .find(|(_, t)| t.name() == c.name && LawPart::of(*t) == Some(part))
+                    .map(|(_, t)| (*t, c.estimate))
+            })
+            .collect();
+        let w: f64 = kept.iter().map(|(_, e)| e).sum();
+        if kept.is_empty() || kept.iter().all(|(k, _)| *k == t) || !(w > 0.0) {
+            return 1.0;
+        }
+        let (mut own, mut env) = (0.0, 0.0);
+        for a in self.env.rows.iter().filter_map(|r| r.mid_amplitude_rad) {
+            own += t.loss_per_cycle(a);
+            env += kept
+                .iter()
+                .map(|(k, e)| e / w * k.loss_per_cycle(a))
+                .sum::<f64>();
+        }
+        if own > 0.0 && env > 0.0 {
+            own / env
+        } else {
+            1.0
+        }
+    }
+
+    /// The fit's value of `part` (`x`: the model's parameters) in the units of this envelope's
+    /// coefficient of it (see [`RunEnvelope::ratio`]); `None` when the model lacks the part.
+    fn value(&self, part: LawPart, spec: &ModelSpec, x: &[f64]) -> Option<f64> {
+        let ps = part.params(spec);
+        (!ps.is_empty()).then(|| {
+            ps.iter()
+                .filter_map(|p| {
+                    let (_, t) = DECAY_TERMS.iter().find(|(q, _)| q == p)?;
+                    Some(spec.value_of(*p, x)? * self.ratio(part, *t))
+                })
+                .sum()
+        })
+    }
 }
 
 /// How far beyond the envelope's interval, as a fraction of its estimate, a trajectory fit's
@@ -996,6 +1049,11 @@ fn contradicted_bands(re: &RunEnvelope, spec: &ModelSpec, x: &[f64], z: f64) -> 
         .collect()
 }
 
+/// How much worse (E_θ, ×) a refit under the decay law may fit the trajectories and still be
+/// taken: a law inside every envelope interval and loss band that the motion does not follow
+/// (E_θ ×9 on two decays forced onto one ω0) is no agreement of the views.
+const REFIT_E_THETA_FACTOR: f64 = 2.0;
+
 /// `inner` with some parameters' boxes changed: a refit that the decay law constrains.
 struct Constrained<'a, 'b> {
     inner: &'a StudyObjective<'b>,
@@ -1073,34 +1131,39 @@ pub fn decay_law(
     // the envelope does not see): the part's box becomes the envelope's interval (common to
     // every run that resolves it; none when they have nothing in common: the verdicts say so).
     for part in LawPart::ALL {
-        let (lo, hi) = envs
-            .iter()
-            .flatten()
-            .filter_map(|e| e.resolved(part))
-            .fold((f64::NEG_INFINITY, f64::INFINITY), |a, b| {
-                (a.0.max(b.0), a.1.min(b.1))
-            });
-        let (Some(v), Some(&p)) = (part.value(&spec, &x[..n]), part.params(&spec).first()) else {
+        let Some(&p) = part.params(&spec).first() else {
             continue;
         };
-        let Some(k) = index(p) else { continue };
-        if !(lo.is_finite() && hi.is_finite() && lo <= hi) || (lo..=hi).contains(&v) {
+        let (Some(k), Some(&(_, t))) = (index(p), DECAY_TERMS.iter().find(|(q, _)| *q == p)) else {
+            continue;
+        };
+        // Each run's interval as a box for p: the part's other parameters (c beside M) stay
+        // as fitted, and a dry interval is read in p's units over that run's swings.
+        let (mut lo, mut hi, mut any) = (f64::NEG_INFINITY, f64::INFINITY, false);
+        for e in envs.iter().flatten() {
+            let (Some((e_lo, e_hi)), Some(v)) = (e.resolved(part), e.value(part, &spec, &x[..n]))
+            else {
+                continue;
+            };
+            let r = e.ratio(part, t);
+            let others = v - x[k] * r;
+            lo = lo.max((e_lo - others) / r);
+            hi = hi.min((e_hi - others) / r);
+            any = true;
+        }
+        if !any || !(lo.is_finite() && hi.is_finite() && lo <= hi) || (lo..=hi).contains(&x[k]) {
             continue;
         }
-        // The other parameters of the part (c beside M) stay as fitted.
-        let others = v - x[k];
-        let (b_lo, b_hi) = (
-            (lo - others).max(bounds[k].0),
-            (hi - others).min(bounds[k].1),
-        );
+        let (b_lo, b_hi) = (lo.max(bounds[k].0), hi.min(bounds[k].1));
         if !(b_lo < b_hi) {
             continue;
         }
         actions.push(format!(
-            "{} {} = {v:.3e} was outside the envelope's interval [{lo:.3e}, {hi:.3e}]: refitted \
+            "{} {} = {:.3e} was outside the envelope's interval [{lo:.3e}, {hi:.3e}]: refitted \
              with {} in [{b_lo:.3e}, {b_hi:.3e}]",
             part.name(),
             p.name(),
+            x[k],
             p.name()
         ));
         bounds[k] = (b_lo, b_hi);
@@ -1159,6 +1222,16 @@ pub fn decay_law(
         let (before, after) = (contradictions(&out.params), contradictions(&xr[..n]));
         if after > before {
             notes_refused(&mut actions, before, after, out.e_theta, eval.e_theta);
+        } else if !(eval.e_theta <= REFIT_E_THETA_FACTOR * out.e_theta) {
+            // Inside every interval and band, yet the trajectories no longer follow: the
+            // envelopes' law is not one these runs' motion shares with the fit's ω0 (MultiArm's
+            // two decays over 40 s: E_θ 3.50 → 31.6 with one ω0).
+            actions.push(format!(
+                "refit not taken: the trajectories do not follow it (E_θ {:.4} → {:.4}, more \
+                 than ×{REFIT_E_THETA_FACTOR}): the runs' envelopes do not share one decay law \
+                 with this fit (fit them separately)",
+                out.e_theta, eval.e_theta
+            ));
         } else {
             actions.push(format!(
                 "E_θ {:.4} → {:.4} under the decay law",
@@ -1231,12 +1304,21 @@ pub fn decay_law(
             .iter()
             .filter_map(|part| {
                 let (lo, hi) = re.resolved(*part)?;
-                match part.value(&spec, &out.params) {
+                match re.value(*part, &spec, &out.params) {
                     Some(v) if (lo..=hi).contains(&v) => None,
-                    Some(v) => Some(format!(
-                        "{} {v:.3e} outside the envelope's [{lo:.3e}, {hi:.3e}]",
-                        part.name()
-                    )),
+                    Some(v) => {
+                        // A dry part read over the run's swings as the envelope's term says so.
+                        let raw = part.value(&spec, &out.params).unwrap_or(v);
+                        let read = if (v - raw).abs() > 1e-3 * raw.abs() {
+                            format!(" (the fit's {raw:.3e} over these swings)")
+                        } else {
+                            String::new()
+                        };
+                        Some(format!(
+                            "{} {v:.3e}{read} outside the envelope's [{lo:.3e}, {hi:.3e}]",
+                            part.name()
+                        ))
+                    }
                     None => Some(format!(
                         "{} resolved ([{lo:.3e}, {hi:.3e}]) but not in the model",
                         part.name()
@@ -1295,8 +1377,10 @@ fn notes_refused(actions: &mut Vec<String>, before: usize, after: usize, e0: f64
 /// [`shared_omega0_notes`]) are also fitted one by one, each with its own ω0, its own swing
 /// centre (`encoder_offset`: the hanging angle) and its own damping, so that the report gives
 /// every run the values its swings say beside the forced shared fit. Each fit goes through the
-/// run's [`decay_law`] (with `ctx`), whose refit notes, if any, come with it. Empty when the runs
-/// agree (or are one run, or not free decays).
+/// run's [`decay_law`] (with `ctx`): its verdict (the run's fit against the run's envelope,
+/// stated for every run's own fit: when a shared ω0 is refused these fits are the answer) and
+/// its refit notes, if any, come with it, each beginning with [`alone_prefix`]. Empty when the
+/// runs agree (or are one run, or not free decays).
 pub fn per_run_fits(
     runs: &[PreparedRun],
     ctx: &crate::pipeline::Context,
@@ -1310,15 +1394,29 @@ pub fn per_run_fits(
         .map(|r| {
             let one = std::slice::from_ref(r);
             let (fit, notes) = decay_law(one, ctx, cfg, identify(one, cfg, None)?);
-            // The run's verdict is stated once, for the shared fit; the refit's note stays.
-            let refit = notes
+            // The run's own decay-law verdict (its fit against its envelope: the answer when the
+            // shared ω0 is refused), then the refit's note, each marked as the run's own.
+            let own = notes
                 .into_iter()
-                .filter(|n| n.starts_with("decay law, fit"))
-                .map(|n| format!("{} alone: {n}", r.id))
+                .map(|n| format!("{}{n}", alone_prefix(&r.id)))
                 .collect();
-            Ok((fit, refit))
+            Ok((fit, own))
         })
         .collect()
+}
+
+/// How the notes of a run's own fit ([`per_run_fits`]) begin: `<id> alone: `.
+pub fn alone_prefix(id: &str) -> String {
+    format!("{id} alone: ")
+}
+
+/// The decay-law verdict of run `id`'s own fit ([`per_run_fits`]) among `notes`: `verdict: the
+/// views agree` or `verdict: the views disagree (…)`; `None` when the run has no own fit or no
+/// envelope (then its note says the trajectory fit is the only view).
+pub fn per_run_verdict<'a>(notes: &'a [String], id: &str) -> Option<&'a str> {
+    let head = format!("{}decay law, run {id}:", alone_prefix(id));
+    let note = notes.iter().find(|n| n.starts_with(&head))?;
+    note.find("; verdict: the views").map(|k| &note[k + 2..])
 }
 
 /// The fits of [`per_run_fits`] by run id (what the outputs' per-run columns read).
@@ -1332,15 +1430,16 @@ pub fn per_run_by_id(
         .collect()
 }
 
-/// One note per run of [`per_run_fits`]: its own ω0, hanging angle and damping, E_θ against the
-/// shared fit's on that run, and its parameters at a bound.
+/// The notes of each run of [`per_run_fits`]: its own ω0, hanging angle and damping, E_θ against
+/// the shared fit's on that run, its decay-law verdict (and refit), and its parameters at a
+/// bound.
 pub fn per_run_notes(
     runs: &[PreparedRun],
     shared: &FitOutcome,
     fits: &[(FitOutcome, Vec<String>)],
 ) -> Vec<String> {
     let mut notes = Vec::new();
-    for (run, (fit, refit)) in runs.iter().zip(fits) {
+    for (run, (fit, law)) in runs.iter().zip(fits) {
         let values: Vec<String> = fit
             .spec
             .params
@@ -1360,11 +1459,11 @@ pub fn per_run_notes(
             values.join(", "),
             fit.e_theta
         ));
-        notes.extend(refit.iter().cloned());
+        notes.extend(law.iter().cloned());
         notes.extend(
             params_at_bounds(std::slice::from_ref(run), fit)
                 .into_iter()
-                .map(|n| format!("{} alone: {n}", run.id)),
+                .map(|n| format!("{}{n}", alone_prefix(&run.id))),
         );
     }
     notes
