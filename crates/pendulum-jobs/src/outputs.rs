@@ -1086,9 +1086,20 @@ fn per_run_summary(text: &mut String, ctx: &Context, m: &FitOutcome) {
             .map_or(f64::NAN, |rf| rf.e_theta);
         let verdict = pendulum_process::identify::per_run_verdict(&ctx.notes, &r.id)
             .unwrap_or("no decay-law verdict: no envelope in the fit's window");
+        let beyond = format!(
+            "{}, run {}:",
+            pendulum_process::identify::BEYOND_WINDOW,
+            r.id
+        );
+        let window_only = if ctx.notes.iter().any(|n| n.starts_with(&beyond)) {
+            " (over the fit window's swings; the whole recording resolves another law: see the \
+             note `decay law beyond the fit window`)"
+        } else {
+            ""
+        };
         let _ = writeln!(
             text,
-            "  {:<8} alone {}  E_θ={:.4} (shared fit {shared_e:.4}); {verdict}",
+            "  {:<8} alone {}  E_θ={:.4} (shared fit {shared_e:.4}); {verdict}{window_only}",
             r.id,
             values.join(" "),
             f.e_theta

@@ -869,9 +869,83 @@ struct RunEnvelope {
     id: String,
     env: pendulum_explain::EnvelopeFit,
     bands: Vec<pendulum_explain::LossBand>,
+    /// The envelope of the whole recording from t = 0, when it swings on after the fit's
+    /// window (more turning points): what the decay law is beyond the swings the fit saw.
+    recording: Option<pendulum_explain::EnvelopeFit>,
+}
+
+/// How the note begins that says a run's recording resolves another decay law beyond the fit's
+/// window ([`decay_law`]).
+pub const BEYOND_WINDOW: &str = "decay law beyond the fit window";
+
+/// The parts of the decay law that `env` resolves (a catalogue term of the part with its
+/// interval clear of 0).
+fn resolved_parts(env: &pendulum_explain::EnvelopeFit) -> Vec<LawPart> {
+    LawPart::ALL
+        .into_iter()
+        .filter(|part| {
+            env.catalogue.iter().any(|c| {
+                c.significant
+                    && c.ci_low > 0.0
+                    && DECAY_TERMS
+                        .iter()
+                        .any(|(_, t)| t.name() == c.name && LawPart::of(*t) == Some(*part))
+            })
+        })
+        .collect()
+}
+
+/// The smallest and largest swing of an envelope, rad.
+fn swing_range(env: &pendulum_explain::EnvelopeFit) -> (f64, f64) {
+    env.rows
+        .iter()
+        .filter_map(|r| r.mid_amplitude_rad)
+        .fold((f64::INFINITY, 0.0), |a, v| (a.0.min(v), a.1.max(v)))
 }
 
 impl RunEnvelope {
+    /// When the recording swings on after the fit's window and its envelope resolves other
+    /// parts of the decay law than the window's (MultiArm's large decay: over identify's 10 s,
+    /// A 1.20–1.57 rad, viscous + quadratic drag; over the whole recording, A 0.25–1.62 rad,
+    /// quadratic drag + dry friction, no viscous), a note saying that the verdict is the
+    /// window's law, with the recording's terms.
+    fn beyond_window(&self) -> Option<String> {
+        let rec = self.recording.as_ref()?;
+        let (win, all) = (resolved_parts(&self.env), resolved_parts(rec));
+        if win == all || all.is_empty() {
+            return None;
+        }
+        let names = |ps: &[LawPart]| -> String {
+            if ps.is_empty() {
+                "none".into()
+            } else {
+                ps.iter().map(|p| p.name()).collect::<Vec<_>>().join(", ")
+            }
+        };
+        let terms: Vec<String> = rec
+            .catalogue
+            .iter()
+            .map(|c| {
+                format!(
+                    "{} {:.3e} [{:.3e}, {:.3e}]",
+                    c.name, c.estimate, c.ci_low, c.ci_high
+                )
+            })
+            .collect();
+        let ((w_lo, w_hi), (r_lo, r_hi)) = (swing_range(&self.env), swing_range(rec));
+        Some(format!(
+            "{BEYOND_WINDOW}, run {}: the fit saw swings of {w_lo:.3}–{w_hi:.3} rad, where the envelope resolves {}; over the whole recording ({r_lo:.3}–{r_hi:.3} \
+             rad, {} turning points) it keeps {} and resolves {}: the verdict is the decay law \
+             of the window's swings, not of the recording's (a longer --window-s fits more of \
+             the decay)",
+            self.id,
+            names(&win),
+            rec.rows.len(),
+            terms.join(", "),
+            names(&all)
+        ))
+    }
+
     /// The envelope resolves `part` (a catalogue coefficient of it with its interval clear of
     /// 0): the part's interval (the sum over both dry terms when it kept both), widened by
     /// [`ENVELOPE_TOLERANCE`] of its estimate on either side.
@@ -970,10 +1044,14 @@ fn run_envelope(
     // decimated to 100 Hz, which hides the encoder's step (a large swing never shows one count
     // between two of them) and so the resolution that ends the analysis.
     let window_s = run.t.last().copied().unwrap_or(0.0) / run.omega0_rad_s;
+    let mut after: Option<(&[f64], &[f64])> = None;
     let (t_s, theta): (Vec<f64>, Vec<f64>) = match raw {
         Some((rd, al)) => {
             let lo = rd.enc_t_s.partition_point(|&x| x < al.t0_s);
             let hi = rd.enc_t_s.partition_point(|&x| x <= al.t0_s + window_s);
+            if hi < rd.enc_t_s.len() {
+                after = Some((&rd.enc_t_s[lo..], &rd.theta_rad[lo..]));
+            }
             (rd.enc_t_s[lo..hi].to_vec(), rd.theta_rad[lo..hi].to_vec())
         }
         None => (
@@ -982,6 +1060,10 @@ fn run_envelope(
         ),
     };
     let env = pendulum_explain::envelope_with(&t_s, &theta, resolution_rad).ok()?;
+    // The whole recording, when it swings on after the window.
+    let recording = after
+        .and_then(|(t, th)| pendulum_explain::envelope_with(t, th, resolution_rad).ok())
+        .filter(|rec| rec.rows.len() > env.rows.len());
     let mut rows: Vec<(f64, f64)> = env
         .rows
         .iter()
@@ -1015,6 +1097,7 @@ fn run_envelope(
         id: run.id.clone(),
         env,
         bands,
+        recording,
     })
 }
 
@@ -1362,6 +1445,7 @@ pub fn decay_law(
             bands.join("; "),
             re.env.resolution.describe(),
         ));
+        notes.extend(re.beyond_window());
     }
     if !actions.is_empty() {
         notes.push(format!(
@@ -1405,8 +1489,10 @@ pub fn per_run_fits(
             let (fit, notes) = decay_law(one, ctx, cfg, identify(one, cfg, None)?);
             // The run's own decay-law verdict (its fit against its envelope: the answer when the
             // shared ω0 is refused), then the refit's note, each marked as the run's own.
+            // (What the recording says beyond the fit window is the shared fit's note already.)
             let own = notes
                 .into_iter()
+                .filter(|n| !n.starts_with(BEYOND_WINDOW))
                 .map(|n| format!("{}{n}", alone_prefix(&r.id)))
                 .collect();
             Ok((fit, own))
@@ -1523,6 +1609,7 @@ mod decay_law_tests {
                 notes: Vec::new(),
             },
             bands: Vec::new(),
+            recording: None,
         }
     }
 
