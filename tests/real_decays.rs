@@ -225,7 +225,9 @@ fn identify(camp: &Path, out: &Path) -> String {
 /// envelope's interval in the plain fit, is put back); fitted together (one ω0 and one damping
 /// for two recordings whose envelopes differ), the verdict says the views disagree instead of
 /// forcing either, and a damping term of 4e-4 is not called "at its lower bound 0". Their own
-/// fits (issue 16 item 4) are in `runs.parquet`, each ω0 within 1 % of its swings' periods.
+/// fits (issue 16 item 4) are in `runs.parquet`, each ω0 within 1 % of its swings' periods, and
+/// are the answer: each states its verdict (the views agree), and each is a row of
+/// `params.parquet` (`scope = run`) with its residuals in `residuals.parquet`.
 #[test]
 fn regression_issue_16_multiarm_identify_one_decay_law() {
     let Some(dir) = data_dir("regression_issue_16_multiarm_identify_one_decay_law") else {
@@ -250,6 +252,14 @@ fn regression_issue_16_multiarm_identify_one_decay_law() {
             assert!(v.contains(part), "{part} missing: {v}");
         }
         assert!(v.ends_with("verdict: the views agree"), "{v}");
+        // One identify run: no fit of its own, params.parquet has the shared rows only.
+        let params = tmp.path().join(format!("out-{id}/params.parquet"));
+        assert_eq!(
+            crate::identify::column_str(&params, "scope"),
+            ["shared"],
+            "{id}"
+        );
+        assert!(!text.contains(" alone"), "{text}");
     }
     let camp = tmp.path().join("camp-joint");
     campaign(&dir, &camp, ["identify", "identify"]);
@@ -283,5 +293,95 @@ fn regression_issue_16_multiarm_identify_one_decay_law() {
     for ((w, want), e) in own.iter().zip(&est).zip(&e_own) {
         assert!((w - want).abs() < 0.01 * want, "own omega0 {w} vs {want}");
         assert!(e.is_finite(), "e_theta_own {e}");
+    }
+
+    // The shared ω0 is refused, so each run's own fit is the answer: the summary says so and
+    // every own fit states its decay-law verdict, which agrees with its envelope (the large
+    // decay's after its viscous and quadratic drag are put inside the envelope's intervals).
+    assert!(
+        text.contains("each run's own fit below is its answer"),
+        "{text}"
+    );
+    for id in ["small", "large"] {
+        let own_verdict = text
+            .lines()
+            .find(|l| l.starts_with(&format!("note: {id} alone: decay law, run {id}:")))
+            .unwrap_or_else(|| panic!("no decay-law verdict for {id}'s own fit:\n{text}"));
+        for part in ["envelope (", "fit: ", "loss per cycle: ", "resolution: "] {
+            assert!(own_verdict.contains(part), "{part} missing: {own_verdict}");
+        }
+        assert!(
+            own_verdict.ends_with("verdict: the views agree"),
+            "{own_verdict}"
+        );
+        let line = text
+            .lines()
+            .find(|l| l.trim_start().starts_with(&format!("{id} ")) && l.contains(" alone "))
+            .unwrap_or_else(|| panic!("no summary line for {id}'s own fit:\n{text}"));
+        assert!(line.contains("; verdict: the views agree"), "{line}");
+    }
+    // The large decay's verdicts are those of identify's window (10 s, swings of 1.2–1.6 rad:
+    // viscous + quadratic drag); the whole recording (down to 0.25 rad) resolves dry friction
+    // and no viscous part, and the report says so, once, beside the verdict.
+    let beyond: Vec<&str> = text
+        .lines()
+        .filter(|l| l.starts_with("note: ") && l.contains("decay law beyond the fit window"))
+        .collect();
+    assert_eq!(beyond.len(), 1, "{beyond:?}");
+    assert!(
+        beyond[0].starts_with("note: decay law beyond the fit window, run large:")
+            && beyond[0].contains("resolves quadratic drag, dry friction"),
+        "{}",
+        beyond[0]
+    );
+
+    // params.parquet: the shared fit, then each run's own fit (scope = run, its run_id), the
+    // values runs.parquet reports for it.
+    let params = tmp.path().join("out-joint/params.parquet");
+    assert_eq!(
+        crate::identify::column_str(&params, "scope"),
+        ["shared", "run", "run"]
+    );
+    assert_eq!(
+        crate::identify::column_str(&params, "run_id"),
+        ["", "small", "large"]
+    );
+    assert_eq!(
+        crate::identify::column_str(&params, "model"),
+        ["reference"; 3]
+    );
+    let w_rows = crate::identify::column_f64(&params, "omega0_rad_s");
+    let e_rows = crate::identify::column_f64(&params, "e_theta");
+    for j in 0..2 {
+        assert!((w_rows[j + 1] - own[j]).abs() < 1e-9, "{w_rows:?} {own:?}");
+        assert!(
+            (e_rows[j + 1] - e_own[j]).abs() < 1e-9,
+            "{e_rows:?} {e_own:?}"
+        );
+    }
+    // residuals.parquet: each run's residual under its own fit too (scope = run), whose
+    // multiple-shooting segments sum to that fit's E_θ.
+    let res = tmp.path().join("out-joint/residuals.parquet");
+    let (r_id, r_scope, r_mode) = (
+        crate::identify::column_str(&res, "run_id"),
+        crate::identify::column_str(&res, "scope"),
+        crate::identify::column_str(&res, "mode"),
+    );
+    let resid = crate::identify::column_f64(&res, "residual");
+    for (j, id) in ["small", "large"].into_iter().enumerate() {
+        let e: f64 = (0..resid.len())
+            .filter(|&i| r_id[i] == id && r_scope[i] == "run" && r_mode[i] == "segments")
+            .map(|i| resid[i].abs())
+            .sum();
+        assert!(
+            (e - e_own[j]).abs() < 0.01 * e_own[j],
+            "{id}: own-fit residual {e} vs e_theta_own {}",
+            e_own[j]
+        );
+        assert!(
+            (0..resid.len())
+                .any(|i| r_id[i] == id && r_scope[i] == "run" && r_mode[i] == "free_run"),
+            "{id}: no free-run residual under its own fit"
+        );
     }
 }

@@ -205,10 +205,34 @@ fn regression_issue_16_item_4_per_run_omega0_in_runs_parquet() {
     );
     std::fs::write(camp.join("campaign.toml"), toml).expect("write campaign");
     let out = tmp.path().join("out");
-    identify(&camp, &out);
+    let text = identify(&camp, &out);
     let runs = out.join("runs.parquet");
     let ids = crate::identify::column_str(&runs, "run_id");
     assert_eq!(ids, ["twin1", "twin3"]);
+    // Each twin's own fit: its decay-law verdict (the twin's one law: the views agree) and its
+    // row in params.parquet (scope = run), the ω0 runs.parquet reports for it.
+    for id in &ids {
+        let v = text
+            .lines()
+            .find(|l| l.starts_with(&format!("note: {id} alone: decay law, run {id}:")))
+            .unwrap_or_else(|| panic!("no verdict for {id}'s own fit:\n{text}"));
+        assert!(v.ends_with("verdict: the views agree"), "{v}");
+    }
+    let params = out.join("params.parquet");
+    assert_eq!(
+        crate::identify::column_str(&params, "scope"),
+        ["shared", "run", "run"]
+    );
+    assert_eq!(
+        crate::identify::column_str(&params, "run_id"),
+        ["", "twin1", "twin3"]
+    );
+    let w_rows = crate::identify::column_f64(&params, "omega0_rad_s");
+    let own_w = crate::identify::column_f64(&runs, "omega0_own_rad_s");
+    assert!(
+        (w_rows[1] - own_w[0]).abs() < 1e-9 && (w_rows[2] - own_w[1]).abs() < 1e-9,
+        "{w_rows:?} {own_w:?}"
+    );
     let own = crate::identify::column_f64(&runs, "omega0_own_rad_s");
     for (j, (got, want)) in own.iter().zip(&w).enumerate() {
         assert!(
@@ -246,6 +270,10 @@ fn regression_issue_16_item_4_per_run_omega0_in_runs_parquet() {
     let out = tmp.path().join("out-shared");
     let text = identify(&camp, &out);
     assert!(!text.contains("alone"), "{text}");
+    assert_eq!(
+        crate::identify::column_str(&out.join("params.parquet"), "scope"),
+        ["shared"]
+    );
     let runs = out.join("runs.parquet");
     for c in OWN_COLUMNS {
         let v = crate::identify::column_f64(&runs, c);

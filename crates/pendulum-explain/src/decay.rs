@@ -1196,6 +1196,12 @@ pub fn envelope_with(
     envelope_of(&tps, noise, res, 1.96)
 }
 
+/// How the envelope's note begins when its polynomial has a constant (in words, dry friction)
+/// but the exact pendulum's terms keep no dry term: the constant is the curvature of the
+/// pendulum's viscous or quadratic loss at large swings, not friction.
+pub const DRY_CONSTANT_NOTE: &str =
+    "the polynomial's constant is not by itself dry friction at amplitudes";
+
 fn envelope_of(
     tps: &[TurningPoint],
     noise: f64,
@@ -1379,6 +1385,19 @@ fn envelope_of(
              (2A/sin A per half swing): an A² term in the polynomial is not by itself quadratic drag"
                 .into(),
         );
+    }
+    if polynomial_best.iter().any(|c| c.name == "c0")
+        && !catalogue.is_empty()
+        && !catalogue
+            .iter()
+            .any(|c| c.name == "coulomb_constant" || c.name == "coulomb_bearing")
+    {
+        notes.push(format!(
+            "{DRY_CONSTANT_NOTE} {amin:.3}–{amax:.3} rad: a viscous loss per cycle there is \
+             not proportional to A (fitted as c0 + c2·A² over 1.24–1.50 rad, a purely viscous \
+             loss has c0 ≈ 0.24 of its mean), and the catalogue terms, fitted with the exact \
+             curves, keep no dry term"
+        ));
     }
     notes.push(
         "successive losses share turning points (negatively correlated errors): the polynomial's \

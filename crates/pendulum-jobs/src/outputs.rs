@@ -303,16 +303,39 @@ pub fn not_separable(rig: &RigParams) -> String {
 }
 
 /// Rows of params.parquet: one per fitted (or given) model, dimensionless values for the first
-/// identify run's rig and crank speed. A free-decay model (excitation off) has its fitted ω0 and
-/// ratios; the crank's columns and the SI damping (a, b, μ) are NaN, and its `not_separable`
-/// says why; with the campaign's m and l it also has the pivot inertia and SI torques.
+/// identify run's rig and crank speed (`scope = shared`, `run_id` empty). A free-decay model
+/// (excitation off) has its fitted ω0 and ratios; the crank's columns and the SI damping (a, b,
+/// μ) are NaN, and its `not_separable` says why; with the campaign's m and l it also has the
+/// pivot inertia and SI torques.
+///
+/// Issue 16: free decays whose ω0 differ are also fitted one by one
+/// ([`pendulum_process::identify::per_run_fits`]); each such fit is one more row after the
+/// shared ones, same `model`, `scope = run` and the run's id in `run_id`, on that run's rig. A
+/// reader that takes the first row of a model (validate, design, bifurcate) keeps the shared
+/// fit; campaigns without per-run fits (shaker runs, runs sharing ω0) have the shared rows only.
 pub fn params_columns(ctx: &Context, fits: &[FitOutcome]) -> Vec<Column> {
     let first = ctx
         .runs
         .iter()
         .find(|r| r.role == Role::Identify)
         .or(ctx.runs.first());
+    // (fit, the run it is its own fit of, or None for the shared fit, the rig it is read on).
+    let mut rows: Vec<(&FitOutcome, Option<&str>, &pendulum_process::RunData)> = Vec::new();
+    if let Some(r) = first {
+        rows.extend(fits.iter().map(|f| (f, None, r)));
+        for f in fits {
+            let Some(own) = ctx.per_run.get(&f.spec.name) else {
+                continue;
+            };
+            for run in &ctx.runs {
+                if let Some(o) = own.get(&run.id) {
+                    rows.push((o, Some(run.id.as_str()), run));
+                }
+            }
+        }
+    }
     let mut model = Vec::new();
+    let (mut scope, mut run_id) = (Vec::new(), Vec::new());
     let (mut excitation, mut separable) = (Vec::new(), Vec::new());
     let mut cols: Vec<(String, String, Vec<f64>)> = Vec::new();
     let mut push = |name: &str, unit: &str, v: f64, row: usize| {
@@ -325,17 +348,15 @@ pub fn params_columns(ctx: &Context, fits: &[FitOutcome]) -> Vec<Column> {
             cols.push((name.to_string(), unit.to_string(), vals));
         }
     };
-    for (row, fit) in fits.iter().enumerate() {
+    for (row, &(fit, own, r)) in rows.iter().enumerate() {
         model.push(fit.spec.name.clone());
-        let (rig, omega_hz) = match first {
-            Some(r) => (
-                r.rig.clone(),
-                ctx.alignments
-                    .get(&r.id)
-                    .map_or(r.rig.omega_hz.unwrap_or(0.0), |a| a.omega_hz),
-            ),
-            None => continue,
-        };
+        scope.push(if own.is_some() { "run" } else { "shared" }.to_string());
+        run_id.push(own.unwrap_or_default().to_string());
+        let rig = r.rig.clone();
+        let omega_hz = ctx
+            .alignments
+            .get(&r.id)
+            .map_or(r.rig.omega_hz.unwrap_or(0.0), |a| a.omega_hz);
         if fit.spec.is_free_decay() {
             excitation.push("none".to_string());
             separable.push(not_separable(&rig));
@@ -387,6 +408,8 @@ pub fn params_columns(ctx: &Context, fits: &[FitOutcome]) -> Vec<Column> {
     }
     out.push(strs("excitation", excitation));
     out.push(strs("not_separable", separable));
+    out.push(strs("scope", scope));
+    out.push(strs("run_id", run_id));
     out
 }
 
@@ -778,7 +801,7 @@ pub fn write_outputs_checked(
     let (mut cv_model, mut cv_gen) = (Vec::new(), Vec::new());
     let mut cvv: Vec<Vec<f64>> = vec![Vec::new(); 3];
     let (mut rs_run, mut rs_model, mut rs_role) = (Vec::new(), Vec::new(), Vec::new());
-    let (mut rs_mode, mut rs_segment) = (Vec::new(), Vec::new());
+    let (mut rs_mode, mut rs_segment, mut rs_scope) = (Vec::new(), Vec::new(), Vec::new());
     let mut rsv: Vec<Vec<f64>> = vec![Vec::new(); 7];
     for m in &models {
         let val = validation_of(ctx, &m.spec.name);
@@ -811,10 +834,12 @@ pub fn write_outputs_checked(
             cvv[1].push(w);
             cvv[2].push(mean);
         }
-        // The residual the fit minimised (mode `segments`), then the free run (mode `free_run`).
+        // The residual the fit minimised (mode `segments`), then the free run (mode `free_run`);
+        // scope `shared` for the model's fit, `run` for a run's own fit (issue 16).
         let mut push_rows = |id: &str,
                              role: Role,
                              mode: &str,
+                             scope: &str,
                              s: &ResidualSeries,
                              segment: &dyn Fn(usize) -> i64| {
             for k in 0..s.t.len() {
@@ -822,6 +847,7 @@ pub fn write_outputs_checked(
                 rs_model.push(m.spec.name.clone());
                 rs_role.push(role.as_str().to_string());
                 rs_mode.push(mode.to_string());
+                rs_scope.push(scope.to_string());
                 rs_segment.push(segment(k));
                 let v = [
                     s.t[k],
@@ -837,12 +863,17 @@ pub fn write_outputs_checked(
                 }
             }
         };
+        let x_label = if m.spec.is_free_decay() {
+            "time from the first turning point (s)"
+        } else {
+            "time from the first at-speed peak (s)"
+        };
         for (id, role, s, segments) in segment_residuals_of(ctx, m, val)? {
-            push_rows(&id, role, "segments", &s, &|k| segments[k] as i64);
+            push_rows(&id, role, "segments", "shared", &s, &|k| segments[k] as i64);
         }
         let free_runs = residuals_of(ctx, m, val, 60.0)?;
         for (id, role, s) in &free_runs {
-            push_rows(id, *role, "free_run", s, &|_| -1);
+            push_rows(id, *role, "free_run", "shared", s, &|_| -1);
         }
         for (id, role, s) in free_runs {
             let png = out_file(
@@ -850,13 +881,31 @@ pub fn write_outputs_checked(
                 &format!("history_{}_{}.png", m.spec.name.replace('+', "_"), id),
                 inputs,
             )?;
-            let x_label = if m.spec.is_free_decay() {
-                "time from the first turning point (s)"
-            } else {
-                "time from the first at-speed peak (s)"
-            };
             history_plot(&png, &id, &m.spec.name, role, &s, x_label)?;
             plots.push(png);
+        }
+        // Each run's own fit (free decays whose ω0 differ), on that run alone: the same two
+        // modes, scope `run`, and its own history plot (`history_<model>_<run>_alone.png`).
+        let alone = ctx.per_run.get(&m.spec.name);
+        for own in ctx
+            .runs
+            .iter()
+            .filter_map(|r| alone.and_then(|o| o.get(&r.id)))
+        {
+            for (id, role, s, segments) in segment_residuals_of(ctx, own, None)? {
+                push_rows(&id, role, "segments", "run", &s, &|k| segments[k] as i64);
+            }
+            for (id, role, s) in residuals_of(ctx, own, None, 60.0)? {
+                push_rows(&id, role, "free_run", "run", &s, &|_| -1);
+                let png = out_file(
+                    out,
+                    &format!("history_{}_{}_alone.png", m.spec.name.replace('+', "_"), id),
+                    inputs,
+                )?;
+                let title = format!("{} (fitted alone)", m.spec.name);
+                history_plot(&png, &id, &title, role, &s, x_label)?;
+                plots.push(png);
+            }
         }
         if m.convergence.len() > 1 {
             let png = out_file(
@@ -908,6 +957,7 @@ pub fn write_outputs_checked(
             strs("role", rs_role),
             strs("mode", rs_mode),
             ints("segment", rs_segment),
+            strs("scope", rs_scope),
         ];
         let names = [
             ("t", "1 (t = ω0·τ)"),
@@ -986,6 +1036,7 @@ pub fn write_outputs_checked(
                 }
             );
         }
+        per_run_summary(&mut text, ctx, m);
     }
     for n in &ctx.notes {
         let _ = writeln!(text, "note: {n}");
@@ -997,6 +1048,63 @@ pub fn write_outputs_checked(
         plots,
         text,
     })
+}
+
+/// The printed summary's block of each run's own fit, when the model has them (issue 16: free
+/// decays whose ω0 differ, where the shared fit forces one ω0 and one damping on all): its
+/// values, its E_θ beside the shared fit's on that run, and its decay-law verdict. When a shared
+/// ω0 is refused these are the answer, and the block says so.
+fn per_run_summary(text: &mut String, ctx: &Context, m: &FitOutcome) {
+    let Some(own) = ctx.per_run.get(&m.spec.name) else {
+        return;
+    };
+    let num = |v: f64| {
+        if v != 0.0 && v.abs() < 0.1 {
+            format!("{v:.3e}")
+        } else {
+            format!("{v:.5}")
+        }
+    };
+    let _ = writeln!(
+        text,
+        "  the runs do not share one omega0 (see the notes): each run's own fit below is its \
+         answer, the shared fit above is forced (params.parquet and residuals.parquet: scope = run)"
+    );
+    for r in &ctx.runs {
+        let Some(f) = own.get(&r.id) else { continue };
+        let values: Vec<String> = f
+            .spec
+            .params
+            .iter()
+            .zip(&f.params)
+            .map(|(p, v)| format!("{}={}", p.name(), num(*v)))
+            .collect();
+        let shared_e = m
+            .runs
+            .iter()
+            .find(|rf| rf.id == r.id)
+            .map_or(f64::NAN, |rf| rf.e_theta);
+        let verdict = pendulum_process::identify::per_run_verdict(&ctx.notes, &r.id)
+            .unwrap_or("no decay-law verdict: no envelope in the fit's window");
+        let beyond = format!(
+            "{}, run {}:",
+            pendulum_process::identify::BEYOND_WINDOW,
+            r.id
+        );
+        let window_only = if ctx.notes.iter().any(|n| n.starts_with(&beyond)) {
+            " (over the fit window's swings; the whole recording resolves another law: see the \
+             note `decay law beyond the fit window`)"
+        } else {
+            ""
+        };
+        let _ = writeln!(
+            text,
+            "  {:<8} alone {}  E_θ={:.4} (shared fit {shared_e:.4}); {verdict}{window_only}",
+            r.id,
+            values.join(" "),
+            f.e_theta
+        );
+    }
 }
 
 fn history_plot(
