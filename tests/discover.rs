@@ -391,16 +391,34 @@ fn regression_issue_5_finds_dry_torque_and_position_torque_together() {
     assert_pair_found(3000, 7000, "coulomb_constant", "position_torque");
 }
 
-/// Issue 14: breakaway friction (`stribeck`) hidden alone on a drawn design is named alone,
-/// within 25 % of its T_s, and not mistaken for the constant dry torque it resembles at speed.
-/// Still a known failure on this draw (T_s = 1.083e-2 N·m, v_s = 0.258 rad/s), now with a
-/// shaped stribeck column (`weak::shaped_columns`): the screen's profile puts T_s at 4.3e-4 N·m
-/// with ΔBIC +10.7, so nothing is named (and nothing else either: coulomb_constant 2.5e-5 N·m,
-/// ΔBIC +5.9); only the free-segment envelopes show a dry torque (coulomb_constant
-/// 2.157e-3 N·m). The breakaway acts for ~2 v_s/|θ''| ≈ 20 ms at each reversal, so a window sees
-/// mostly T_s v_s² (see `weak::shaped_tests`); the survey names 2 of 5 drawn stribecks (README).
+/// Issue 14: breakaway friction (`stribeck`) hidden alone on a drawn design (T_s = 1.083e-2 N·m,
+/// v_s = 0.258 rad/s) is named alone, and not mistaken for the constant dry torque it resembles
+/// at speed. The screen cannot see it (its shaped column's ΔBIC is +10.7: the breakaway acts for
+/// ~2 v_s/|θ''| ≈ 20 ms at each reversal, so a window sees mostly T_s v_s², and the windows
+/// where the pendulum may stick are left out); the second look at the dry frictions finds it on
+/// the trajectories (held-out E_θ fall 36 % ± 12 %, coulomb_constant's 19 % ± 6 % with a refit
+/// that disagrees with its screen).
 #[test]
-#[ignore = "known failure (issue 14): the breakaway on this draw is below the screen's ΔBIC −10 (+10.7); see the doc comment"]
+fn issue_14_second_look_names_the_breakaway_not_a_constant_dry_torque() {
+    let (truth, spec, base, a, b, mu) = draw("stribeck", &mut rng(14_000));
+    eprintln!("hidden stribeck: {truth:.4e} ({spec}), base {}", base.name());
+    let s = discover(14_001, base, a, b, mu, &spec);
+    assert_eq!(s.discovery.accepted(), vec!["stribeck"], "{}", s.discovery);
+    let row = s
+        .discovery
+        .rows
+        .iter()
+        .find(|r| r.effect == "stribeck")
+        .expect("a stribeck row");
+    assert!(row.note.contains("second look"), "{}", row.note);
+    assert!(row.estimate > 0.0 && row.heldout_gain > 0.0, "{row:?}");
+}
+
+/// The same draw's size: the trajectory refit's T_s is 5.45e-3 N·m, −50 % of the truth, and
+/// the survey's named breakaways are off by −36 % and +19 % too (README): the refit trades T_s
+/// against v_s and μ, and the screen's value against v_s.
+#[test]
+#[ignore = "known failure (issue 14): the breakaway is named but its T_s is 50 % low on this draw; see the doc comment"]
 fn issue_14_finds_stribeck_and_tells_it_from_coulomb_constant() {
     let s = found_when_hidden("stribeck", 14_000, 14_001);
     assert!(!s.discovery.accepted().contains(&"coulomb_constant"));
