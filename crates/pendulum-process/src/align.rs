@@ -495,7 +495,7 @@ pub fn track_crank_phase(run: &RunData, al: &Alignment) -> Option<PhaseTrack> {
     let inf = f64::INFINITY;
     let gn = GnConfig::default()
         .with_max_iterations(10)
-        .with_step_tolerance(vec![1e-9, inf, inf, inf], vec![0.0, 1e-9, 0.0, 0.0]);
+        .with_step_tolerance(vec![1e-9, 0.0, inf, inf], vec![0.0, 1e-9, 0.0, 0.0]);
     let gn = GaussNewton::new(gn).ok()?;
     while a + 2.0 * period <= t_end {
         let b = a + 2.0 * period;
@@ -751,8 +751,7 @@ impl LeastSquaresProblem for CrankBlock<'_> {
 }
 
 /// [`fit_speed_drift`]'s model a_z = c0 + G·r·[(2πΩ(τ))² f''(φ) + 2π(dΩ/dτ) f'(φ)] on samples
-/// `idx`, in p = [c0, G, Ω0 (Hz), dΩ/dτ (Hz/s), δ (s)], τ = t − t0 − δ; Jacobian by central
-/// differences with fixed steps.
+/// `idx`, in p = [c0, G, Ω0 (Hz), dΩ/dτ (Hz/s), δ (s)], τ = t − t0 − δ.
 struct DriftProblem<'a> {
     t: &'a [f64],
     az: &'a [f64],
@@ -760,6 +759,19 @@ struct DriftProblem<'a> {
     t0: f64,
     r: f64,
     lambda: f64,
+}
+
+impl DriftProblem<'_> {
+    fn model(&self, p: &[f64], ti: f64) -> f64 {
+        let two_pi = 2.0 * std::f64::consts::PI;
+        let tau = ti - self.t0 - p[4];
+        let phi = two_pi * (p[2] * tau + 0.5 * p[3] * tau * tau);
+        let rate = two_pi * (p[2] + p[3] * tau);
+        p[0] + p[1]
+            * self.r
+            * (rate * rate * crank_f2(phi, self.lambda)
+                + two_pi * p[3] * crank_f1(phi, self.lambda))
+    }
 }
 
 impl LeastSquaresProblem for DriftProblem<'_> {
@@ -770,24 +782,29 @@ impl LeastSquaresProblem for DriftProblem<'_> {
         vec![(f64::NEG_INFINITY, f64::INFINITY); 5]
     }
     fn residuals(&self, p: &[f64]) -> Option<Vec<f64>> {
-        let two_pi = 2.0 * std::f64::consts::PI;
-        let model = |ti: f64| {
-            let tau = ti - self.t0 - p[4];
-            let phi = two_pi * (p[2] * tau + 0.5 * p[3] * tau * tau);
-            let rate = two_pi * (p[2] + p[3] * tau);
-            p[0] + p[1]
-                * self.r
-                * (rate * rate * crank_f2(phi, self.lambda)
-                    + two_pi * p[3] * crank_f1(phi, self.lambda))
-        };
         Some(
             self.idx
                 .iter()
-                .map(|&i| self.az[i] - model(self.t[i]))
+                .map(|&i| self.az[i] - self.model(p, self.t[i]))
                 .collect(),
         )
     }
-    fn fd_step(&self, _p: &[f64], j: usize) -> f64 {
-        [1e-4, 1e-7, 1e-8, 1e-8, 1e-7][j]
+    /// Central differences of the model itself with fixed steps (not of a_z − model, which
+    /// would put the data into the cancellation).
+    fn jacobian(&self, p: &[f64], _r: &[f64]) -> Option<Vec<Vec<f64>>> {
+        let steps = [1e-4, 1e-7, 1e-8, 1e-8, 1e-7];
+        let mut cols = vec![Vec::with_capacity(self.idx.len()); 5];
+        for &i in self.idx {
+            for (k, col) in cols.iter_mut().enumerate() {
+                let (mut hi, mut lo) = ([0.0; 5], [0.0; 5]);
+                hi.copy_from_slice(p);
+                lo.copy_from_slice(p);
+                hi[k] += steps[k];
+                lo[k] -= steps[k];
+                let d = self.model(&hi, self.t[i]) - self.model(&lo, self.t[i]);
+                col.push(-d / (2.0 * steps[k]));
+            }
+        }
+        Some(cols)
     }
 }
