@@ -172,11 +172,14 @@ impl<P: LeastSquaresProblem + Sync> Problem for SumOfSquares<P> {
     }
 }
 
+/// A problem's box and a start point projected into it.
+pub(crate) type BoxAndStart = (Vec<(f64, f64)>, Vec<f64>);
+
 /// Checks `problem` and `x0` and returns the box and `x0` projected into it.
 pub(crate) fn prepare<P: LeastSquaresProblem + ?Sized>(
     problem: &P,
     x0: &[f64],
-) -> Result<(Vec<(f64, f64)>, Vec<f64>), FitError> {
+) -> Result<BoxAndStart, FitError> {
     let dim = problem.dim();
     let bounds = problem.bounds();
     if dim == 0 || bounds.len() != dim {

@@ -693,7 +693,7 @@ impl LeastSquaresProblem for CrankWindow<'_> {
         Some(r.collect())
     }
     fn jacobian(&self, p: &[f64], _r: &[f64]) -> Option<Vec<Vec<f64>>> {
-        let mut cols = vec![Vec::with_capacity(self.idx.len()); 4];
+        let mut cols: Vec<Vec<f64>> = (0..4).map(|_| Vec::with_capacity(self.idx.len())).collect();
         for &i in self.idx {
             let (_, j) = self.model(p, self.t[i]);
             for (c, v) in cols.iter_mut().zip(j) {
@@ -730,7 +730,9 @@ impl LeastSquaresProblem for CrankBlock<'_> {
         Some(self.range.clone().map(|i| self.az[i] - model(i)).collect())
     }
     fn jacobian(&self, p: &[f64], _r: &[f64]) -> Option<Vec<Vec<f64>>> {
-        let mut cols = vec![Vec::with_capacity(self.range.len()); 4];
+        let mut cols: Vec<Vec<f64>> = (0..4)
+            .map(|_| Vec::with_capacity(self.range.len()))
+            .collect();
         for i in self.range.clone() {
             let dt = self.t[i] - self.tc;
             let phi = p[0] + p[1] * dt;
@@ -793,7 +795,7 @@ impl LeastSquaresProblem for DriftProblem<'_> {
     /// would put the data into the cancellation).
     fn jacobian(&self, p: &[f64], _r: &[f64]) -> Option<Vec<Vec<f64>>> {
         let steps = [1e-4, 1e-7, 1e-8, 1e-8, 1e-7];
-        let mut cols = vec![Vec::with_capacity(self.idx.len()); 5];
+        let mut cols: Vec<Vec<f64>> = (0..5).map(|_| Vec::with_capacity(self.idx.len())).collect();
         for &i in self.idx {
             for (k, col) in cols.iter_mut().enumerate() {
                 let (mut hi, mut lo) = ([0.0; 5], [0.0; 5]);
