@@ -1594,37 +1594,9 @@ impl<'a> Decay<'a> {
         }
     }
 
-    fn jacobian(
-        &self,
-        terms: &[Term],
-        x: &[f64],
-        r: &[f64],
-        segs: &[Seg],
-    ) -> Result<Vec<Vec<f64>>, DecayError> {
-        let lo = Self::lower(terms, x);
-        let mut cols = Vec::with_capacity(x.len());
-        for j in 0..x.len() {
-            let h = Self::step(terms, x, j);
-            let mut xp = x.to_vec();
-            xp[j] += h;
-            let rp = self.residuals(terms, &xp, segs)?;
-            let col: Vec<f64> = if x[j] - h >= lo[j] {
-                let mut xm = x.to_vec();
-                xm[j] -= h;
-                let rm = self.residuals(terms, &xm, segs)?;
-                rp.iter()
-                    .zip(&rm)
-                    .map(|(a, b)| -(a - b) / (2.0 * h))
-                    .collect()
-            } else {
-                rp.iter().zip(r).map(|(a, b)| -(a - b) / h).collect()
-            };
-            cols.push(col);
-        }
-        Ok(cols)
-    }
-
-    /// Levenberg–Marquardt with the parameters projected onto their lower bounds.
+    /// Levenberg–Marquardt ([`pendulum_fit::LevenbergMarquardt`], default schedule) with the
+    /// parameters projected onto their lower bounds; Jacobian of `r = θ − θ_sim` by central
+    /// differences of step [`Self::step`], forward ones next to a bound.
     fn lm(
         &self,
         terms: &[Term],
@@ -1632,113 +1604,48 @@ impl<'a> Decay<'a> {
         segs: &[Seg],
         max_iter: usize,
     ) -> Result<LmOut, DecayError> {
-        let p = x0.len();
-        let lo = Self::lower(terms, x0);
-        let project = |x: &mut Vec<f64>| {
-            for (v, l) in x.iter_mut().zip(&lo) {
-                if *v < *l {
-                    *v = *l;
-                }
+        struct Ls<'p, 'a> {
+            decay: &'p Decay<'a>,
+            terms: &'p [Term],
+            segs: &'p [Seg],
+            lo: Vec<f64>,
+            /// The latest simulation failure, reported instead of the solver's generic error.
+            failure: std::cell::RefCell<Option<DecayError>>,
+        }
+        impl pendulum_fit::LeastSquaresProblem for Ls<'_, '_> {
+            fn dim(&self) -> usize {
+                self.lo.len()
             }
-        };
-        let mut x = x0.to_vec();
-        project(&mut x);
-        let mut r = self.residuals(terms, &x, segs)?;
-        let mut rss: f64 = r.iter().map(|v| v * v).sum();
-        let mut jac = self.jacobian(terms, &x, &r, segs)?;
-        let mut lambda = 1e-3;
-        let mut iters = 0;
-        let mut small_steps = 0;
-        for _ in 0..max_iter {
-            iters += 1;
-            let mut a = vec![0.0; p * p];
-            let mut g = vec![0.0; p];
-            for i in 0..p {
-                for k in 0..p {
-                    if k >= i {
-                        let v: f64 = jac[i].iter().zip(&jac[k]).map(|(u, w)| u * w).sum();
-                        a[i * p + k] = v;
-                        a[k * p + i] = v;
-                    }
-                }
-                g[i] = jac[i].iter().zip(&r).map(|(u, w)| u * w).sum();
+            fn bounds(&self) -> Vec<(f64, f64)> {
+                self.lo.iter().map(|&l| (l, f64::INFINITY)).collect()
             }
-            let mut accepted = None;
-            for _ in 0..14 {
-                // Active set: a parameter on its bound that the step would push out stays put.
-                let mut frozen = vec![false; p];
-                let mut delta = None;
-                for _ in 0..=p {
-                    let mut aa = a.clone();
-                    let mut gg = g.clone();
-                    for i in 0..p {
-                        aa[i * p + i] = a[i * p + i] * (1.0 + lambda) + 1e-300;
-                        if frozen[i] {
-                            for k in 0..p {
-                                aa[i * p + k] = 0.0;
-                                aa[k * p + i] = 0.0;
-                            }
-                            aa[i * p + i] = 1.0;
-                            gg[i] = 0.0;
-                        }
-                    }
-                    let Ok(dl) = solve_spd(&aa, &gg, p) else {
-                        break;
-                    };
-                    let mut changed = false;
-                    for i in 0..p {
-                        if !frozen[i] && x[i] <= lo[i] && dl[i] < 0.0 {
-                            frozen[i] = true;
-                            changed = true;
-                        }
-                    }
-                    delta = Some(dl);
-                    if !changed {
-                        break;
-                    }
-                }
-                let Some(delta) = delta else {
-                    lambda *= 10.0;
-                    continue;
-                };
-                // r = θ − f(x); J = ∂f/∂x; Gauss–Newton step δ = (JᵀJ)⁻¹ Jᵀ r.
-                let mut xn: Vec<f64> = x.iter().zip(&delta).map(|(a, d)| a + d).collect();
-                project(&mut xn);
-                let Ok(rn) = self.residuals(terms, &xn, segs) else {
-                    lambda *= 8.0;
-                    continue;
-                };
-                let rssn: f64 = rn.iter().map(|v| v * v).sum();
-                if rssn.is_finite() && rssn < rss {
-                    accepted = Some((xn, rn, rssn));
-                    lambda = (lambda / 5.0).max(1e-9);
-                    break;
-                }
-                lambda *= 8.0;
+            fn residuals(&self, x: &[f64]) -> Option<Vec<f64>> {
+                let r = self.decay.residuals(self.terms, x, self.segs);
+                r.map_err(|e| *self.failure.borrow_mut() = Some(e)).ok()
             }
-            let Some((xn, rn, rssn)) = accepted else {
-                break;
-            };
-            let rel = (rss - rssn) / rss.max(1e-300);
-            x = xn;
-            r = rn;
-            rss = rssn;
-            jac = self.jacobian(terms, &x, &r, segs)?;
-            if rel < 1e-9 {
-                small_steps += 1;
-                if small_steps >= 2 {
-                    break;
-                }
-            } else {
-                small_steps = 0;
+            fn fd_step(&self, x: &[f64], j: usize) -> f64 {
+                Decay::step(self.terms, x, j)
             }
         }
+        let problem = Ls {
+            decay: self,
+            terms,
+            segs,
+            lo: Self::lower(terms, x0),
+            failure: std::cell::RefCell::new(None),
+        };
+        let config = pendulum_fit::LmConfig::default().with_max_iterations(max_iter);
+        let solver = pendulum_fit::LevenbergMarquardt::new(config).expect("valid LM settings");
+        let out = solver.solve(&problem, x0).map_err(|e| {
+            let failure = problem.failure.take();
+            failure.unwrap_or_else(|| DecayError::Input(format!("least squares: {e}")))
+        })?;
         Ok(LmOut {
-            x,
-            r,
-            jac,
-            rss,
-            iters,
+            x: out.x,
+            r: out.residuals,
+            jac: out.jacobian,
+            rss: out.rss,
+            iters: out.iterations,
         })
     }
 

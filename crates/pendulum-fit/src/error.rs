@@ -29,6 +29,25 @@ pub enum FitError {
         "evaluation at x = {x:?} was abandoned at {value}, which does not exceed the bound {bound}"
     )]
     AbandonBelowBound { x: Vec<f64>, value: f64, bound: f64 },
+    /// A least-squares problem's box for variable `index` has `lo > hi` or a NaN side (infinite
+    /// sides are allowed there).
+    #[error("bounds of variable {index} are [{lo}, {hi}]: expected lo ≤ hi")]
+    BadBox { index: usize, lo: f64, hi: f64 },
+    /// A least-squares start point has the wrong length or a non-finite entry.
+    #[error("start point {x:?}: {reason}")]
+    BadStart { x: Vec<f64>, reason: &'static str },
+    /// A least-squares problem's residuals could not be evaluated at a point the solver cannot
+    /// back off from (the start, or any point for Gauss–Newton), or came back with a changed
+    /// length.
+    #[error("residuals cannot be evaluated at x = {x:?}")]
+    ResidualsFailed { x: Vec<f64> },
+    /// A least-squares problem's Jacobian could not be evaluated at an accepted point.
+    #[error("Jacobian cannot be evaluated at x = {x:?}")]
+    JacobianFailed { x: Vec<f64> },
+    /// Gauss–Newton's normal matrix JᵀJ is not positive definite at `x` (iteration `iteration`,
+    /// counted from 1): some direction is not determined by the residuals.
+    #[error("the normal matrix is singular at x = {x:?} (iteration {iteration})")]
+    Singular { x: Vec<f64>, iteration: usize },
     /// The local rayon pool could not be built.
     #[error("cannot build a thread pool: {0}")]
     ThreadPool(String),

@@ -8,10 +8,17 @@
 //! sequentially from a seeded ChaCha8 stream before the parallel evaluation, so a run is
 //! bit-identical whatever the number of threads, and the optional early abandon of hopeless
 //! trials ([`Cost::AtLeast`]) never changes the trajectory, only the work done.
+//!
+//! Least squares follow the same split: a [`LeastSquaresProblem`] only knows its residuals (and,
+//! by default numerically, their Jacobian), [`LevenbergMarquardt`] and [`GaussNewton`] only know
+//! how to minimise Σ r², and [`SumOfSquares`] hands the same problem to DE or Nelder–Mead.
 
 pub mod de;
 pub mod driver;
 pub mod error;
+pub mod gn;
+pub mod least_squares;
+pub mod lm;
 pub mod polish;
 pub mod problem;
 
@@ -21,5 +28,10 @@ pub use driver::{
     StopReason,
 };
 pub use error::FitError;
+pub use gn::{GaussNewton, GnConfig};
+pub use least_squares::{
+    finite_difference_jacobian, LeastSquaresProblem, LsResult, LsStop, SumOfSquares,
+};
+pub use lm::{LevenbergMarquardt, LmConfig};
 pub use polish::nelder_mead;
 pub use problem::{Cost, Problem};

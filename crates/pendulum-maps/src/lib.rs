@@ -83,11 +83,8 @@ pub(crate) fn with_pool<R: Send>(
     }
 }
 
-/// θ wrapped to [−π, π).
-pub fn wrap_pi(x: f64) -> f64 {
-    let two_pi = 2.0 * std::f64::consts::PI;
-    (x + std::f64::consts::PI).rem_euclid(two_pi) - std::f64::consts::PI
-}
+// θ wrapped to [−π, π): the workspace's one implementation, for the modules' `crate::wrap_pi`.
+use pendulum_numerics::wrap_pi;
 
 /// Index of a class in [`pendulum_model::SteadyClass::ALL`].
 pub fn class_index(c: pendulum_model::SteadyClass) -> usize {

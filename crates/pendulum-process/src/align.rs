@@ -16,8 +16,9 @@
 //! frequency estimated from the swing periods (`pendulum_explain::omega_n_estimate`), since
 //! sqrt(g/l) is wrong for a physical pendulum and m, l may be unknown.
 
+use pendulum_fit::{FitError, GaussNewton, GnConfig, LeastSquaresProblem, LsResult, LsStop};
 use pendulum_model::excitation::{crank_f1, crank_f2};
-use pendulum_numerics::{inverse_spd, median, ols, solve_spd, wls};
+use pendulum_numerics::{inverse_spd, median, ols, wls};
 use serde::{Deserialize, Serialize};
 
 use crate::run::RunData;
@@ -319,60 +320,33 @@ pub fn align(run: &RunData, cfg: &AlignConfig) -> Result<Alignment, ProcessError
         }
     }
     // Fundamental ∝ cos(2πΩ(t − t_mid) − ψ): its peak (φ = 0) is at t_mid + ψ/(2πΩ).
-    let mut p = [mean_az, 1.0, best.1, best.2 / (two_pi * best.1)];
+    let p = [mean_az, 1.0, best.1, best.2 / (two_pi * best.1)];
 
     // (3) Gauss–Newton on (c0, G, Ω, t_p − t_mid).
-    let model = |p: &[f64; 4], ti: f64| -> (f64, [f64; 4]) {
-        let (c0, g, om, tp) = (p[0], p[1], p[2], p[3]);
-        let kk = r * (two_pi * om).powi(2);
-        let dt = ti - t_mid - tp;
-        let phi = two_pi * om * dt;
-        let f2 = crank_f2(phi, lambda);
-        let d3 = f3(phi, lambda);
-        let val = c0 + g * kk * f2;
-        let j = [
-            1.0,
-            kk * f2,
-            g * (2.0 * kk / om * f2 + kk * d3 * two_pi * dt),
-            -g * kk * d3 * two_pi * om,
-        ];
-        (val, j)
+    let window = CrankWindow {
+        t,
+        az,
+        idx: &idx,
+        r,
+        lambda,
+        t_mid,
     };
-    let mut cov = [0.0; 16];
-    let mut rms = 0.0;
-    for iter in 0..30 {
-        let mut jtj = [0.0; 16];
-        let mut jtr = [0.0; 4];
-        let mut ss = 0.0;
-        for &i in &idx {
-            let (v, j) = model(&p, t[i]);
-            let res = az[i] - v;
-            ss += res * res;
-            for a in 0..4 {
-                jtr[a] += j[a] * res;
-                for b in 0..4 {
-                    jtj[a * 4 + b] += j[a] * j[b];
-                }
-            }
-        }
-        let n = idx.len() as f64;
-        rms = (ss / n).sqrt();
-        let delta =
-            solve_spd(&jtj, &jtr, 4).map_err(|_| fail("the crank-model fit is singular".into()))?;
-        let s2 = ss / (n - 4.0).max(1.0);
-        if let Ok(inv) = inverse_spd(&jtj, 4) {
-            for (c, v) in cov.iter_mut().zip(inv) {
-                *c = v * s2;
-            }
-        }
-        for a in 0..4 {
-            p[a] += delta[a];
-        }
-        let small = delta[2].abs() < 1e-12 * p[2] && delta[3].abs() < 1e-10;
-        if small && iter > 1 {
-            break;
-        }
-    }
+    // Converged when Ω moves by < 1e-12 relative and t_p by < 0.1 ns, after at least 3 steps.
+    let inf = f64::INFINITY;
+    let gn = GnConfig::default()
+        .with_max_iterations(30)
+        .with_min_iterations(3)
+        .with_step_tolerance(vec![inf, inf, 0.0, 1e-10], vec![0.0, 0.0, 1e-12, 0.0]);
+    let fit = GaussNewton::new(gn)
+        .and_then(|gn| gn.solve(&window, &p))
+        .map_err(|e| match e {
+            FitError::Singular { .. } => fail("the crank-model fit is singular".into()),
+            e => fail(format!("the crank-model fit failed: {e}")),
+        })?;
+    let n = idx.len() as f64;
+    let rms = (fit.rss / n).sqrt();
+    let cov = covariance(&fit, (n - 4.0).max(1.0)).unwrap_or_else(|| vec![0.0; 16]);
+    let p = fit.x;
     if !(p[1] > 0.0 && p[2] > 0.0) {
         return Err(fail(format!(
             "the crank-model fit diverged (gain {}, speed {} Hz)",
@@ -517,6 +491,12 @@ pub fn track_crank_phase(run: &RunData, al: &Alignment) -> Option<PhaseTrack> {
         residual_rms_m_s2: f64::NAN,
     };
     let mut abs_res: Vec<f64> = Vec::new();
+    // Converged when the phase moves by < 1e-9 rad and the speed by < 1e-9 relative.
+    let inf = f64::INFINITY;
+    let gn = GnConfig::default()
+        .with_max_iterations(10)
+        .with_step_tolerance(vec![1e-9, 0.0, inf, inf], vec![0.0, 1e-9, 0.0, 0.0]);
+    let gn = GaussNewton::new(gn).ok()?;
     while a + 2.0 * period <= t_end {
         let b = a + 2.0 * period;
         let tc = 0.5 * (a + b);
@@ -531,56 +511,27 @@ pub fn track_crank_phase(run: &RunData, al: &Alignment) -> Option<PhaseTrack> {
         // p = [ψ, ω, G, c0]: the block's own gain and offset too, so that a constant-speed
         // alignment's biased amplitude (a drifting crank) or a slowly moving zero-g offset is not
         // counted as a forcing the model does not understand.
-        let mut p = [psi_prev + omega * (tc - tc_prev), omega, g, c0];
-        let model = |p: &[f64; 4], ti: f64| -> f64 {
-            let phi = p[0] + p[1] * (ti - tc);
-            p[3] + p[2] * r * p[1] * p[1] * crank_f2(phi, lambda)
+        let block = CrankBlock {
+            t,
+            az,
+            range: lo..hi,
+            tc,
+            r,
+            lambda,
         };
-        let mut ok = false;
-        let mut cov00 = f64::NAN;
-        for _ in 0..10 {
-            let mut jtj = [0.0; 16];
-            let mut jtr = [0.0; 4];
-            let mut ss = 0.0;
-            for i in lo..hi {
-                let dt = t[i] - tc;
-                let phi = p[0] + p[1] * dt;
-                let res = az[i] - model(&p, t[i]);
-                ss += res * res;
-                let f2 = crank_f2(phi, lambda);
-                let d_psi = p[2] * r * p[1] * p[1] * f3(phi, lambda);
-                let j = [
-                    d_psi,
-                    d_psi * dt + 2.0 * p[2] * r * p[1] * f2,
-                    r * p[1] * p[1] * f2,
-                    1.0,
-                ];
-                for x in 0..4 {
-                    jtr[x] += j[x] * res;
-                    for y in 0..4 {
-                        jtj[x * 4 + y] += j[x] * j[y];
-                    }
-                }
-            }
-            let Ok(d) = solve_spd(&jtj, &jtr, 4) else {
-                break;
-            };
-            let s2 = ss / ((hi - lo) as f64 - 4.0);
-            cov00 = inverse_spd(&jtj, 4).map_or(f64::NAN, |inv| inv[0] * s2);
-            for (pk, dk) in p.iter_mut().zip(&d) {
-                *pk += dk;
-            }
-            if d[0].abs() < 1e-9 && d[1].abs() < 1e-9 * p[1] {
-                ok = true;
-                break;
-            }
-        }
+        let p0 = [psi_prev + omega * (tc - tc_prev), omega, g, c0];
+        let Ok(fit) = gn.solve(&block, &p0) else {
+            break;
+        };
+        let ok = fit.stop == LsStop::Converged;
+        let cov00 = covariance(&fit, (hi - lo) as f64 - 4.0).map_or(f64::NAN, |c| c[0]);
+        let p = fit.x;
         let predicted = psi_prev + omega * (tc - tc_prev);
         // Lost lock: no convergence, or a jump of more than a quarter turn from the prediction.
         if !ok || (p[0] - predicted).abs() > 0.25 * two_pi || !(p[1] > 0.0 && p[2] > 0.0) {
             break;
         }
-        abs_res.extend((lo..hi).map(|i| (az[i] - model(&p, t[i])).abs()));
+        abs_res.extend(fit.residuals.iter().map(|v| v.abs()));
         track.tau_s.push(tc - al.t0_s);
         track.phase_rad.push(p[0]);
         track.phase_sigma_rad.push(cov00.max(1e-12).sqrt());
@@ -644,13 +595,13 @@ pub fn fit_speed_drift(run: &RunData, al: &Alignment) -> Option<DriftFit> {
         return None;
     }
     // p = [c0, G, Ω0 (Hz), dΩ/dτ (Hz/s), δ (s): the peak's shift from al.t0_s].
-    let model = |p: &[f64; 5], ti: f64| -> f64 {
-        let tau = ti - al.t0_s - p[4];
-        let phi = two_pi * (p[2] * tau + 0.5 * p[3] * tau * tau);
-        let rate = two_pi * (p[2] + p[3] * tau);
-        p[0] + p[1]
-            * r
-            * (rate * rate * crank_f2(phi, lambda) + two_pi * p[3] * crank_f1(phi, lambda))
+    let problem = DriftProblem {
+        t,
+        az,
+        idx: &idx,
+        t0: al.t0_s,
+        r,
+        lambda,
     };
     // Start from the phase track's quadratic (Ω at t0, dΩ/dτ, the peak's shift): started from
     // zero drift, Gauss–Newton cannot reach a drift whose phase error is many turns by the end.
@@ -664,55 +615,198 @@ pub fn fit_speed_drift(run: &RunData, al: &Alignment) -> Option<DriftFit> {
             p = [al.az_offset_m_s2, al.accel_gain, om0, drift, delta];
         }
     }
-    let steps = [1e-4, 1e-7, 1e-8, 1e-8, 1e-7];
-    let mut cov = [0.0; 25];
-    let mut rms = f64::NAN;
-    let mut converged = false;
-    for _ in 0..20 {
-        let mut jtj = [0.0; 25];
-        let mut jtr = [0.0; 5];
-        let mut ss = 0.0;
-        for &i in &idx {
-            let v = model(&p, t[i]);
-            let res = az[i] - v;
-            ss += res * res;
-            let mut j = [0.0; 5];
-            for (k, jk) in j.iter_mut().enumerate() {
-                let (mut hi, mut lo) = (p, p);
-                hi[k] += steps[k];
-                lo[k] -= steps[k];
-                *jk = (model(&hi, t[i]) - model(&lo, t[i])) / (2.0 * steps[k]);
-            }
-            for a in 0..5 {
-                jtr[a] += j[a] * res;
-                for b in 0..5 {
-                    jtj[a * 5 + b] += j[a] * j[b];
-                }
-            }
-        }
-        let n = idx.len() as f64;
-        rms = (ss / n).sqrt();
-        let delta = solve_spd(&jtj, &jtr, 5).ok()?;
-        let s2 = ss / (n - 5.0);
-        if let Ok(inv) = inverse_spd(&jtj, 5) {
-            for (c, v) in cov.iter_mut().zip(inv) {
-                *c = v * s2;
-            }
-        }
-        for a in 0..5 {
-            p[a] += delta[a];
-        }
-        if delta[2].abs() < 1e-12 * p[2] && delta[3].abs() < 1e-12 && delta[4].abs() < 1e-10 {
-            converged = true;
-            break;
-        }
-    }
+    // Converged when Ω0 moves by < 1e-12 relative, dΩ/dτ by < 1e-12 Hz/s and δ by < 0.1 ns.
+    let inf = f64::INFINITY;
+    let gn = GnConfig::default()
+        .with_max_iterations(20)
+        .with_step_tolerance(
+            vec![inf, inf, 0.0, 1e-12, 1e-10],
+            vec![0.0, 0.0, 1e-12, 0.0, 0.0],
+        );
+    let fit = GaussNewton::new(gn).ok()?.solve(&problem, &p).ok()?;
+    let n = idx.len() as f64;
+    let rms = (fit.rss / n).sqrt();
+    let var = covariance(&fit, n - 5.0).map_or(0.0, |c| c[3 * 5 + 3]);
+    let converged = fit.stop == LsStop::Converged;
+    let p = fit.x;
     (converged && p[1] > 0.0 && p[2] > 0.0).then_some(DriftFit {
         t0_s: al.t0_s + p[4],
         omega_hz: p[2],
         accel_gain: p[1],
         drift_hz_per_s: p[3],
-        drift_sigma_hz_per_s: cov[3 * 5 + 3].max(0.0).sqrt(),
+        drift_sigma_hz_per_s: var.max(0.0).sqrt(),
         residual_rms_m_s2: rms,
     })
+}
+
+/// (JᵀJ)⁻¹ · rss/`dof` at a least-squares solution, row-major; `None` if JᵀJ is singular.
+fn covariance(fit: &LsResult, dof: f64) -> Option<Vec<f64>> {
+    let s2 = fit.rss / dof;
+    let inv = inverse_spd(&fit.jtj(), fit.x.len()).ok()?;
+    Some(inv.iter().map(|v| v * s2).collect())
+}
+
+/// Step (3) of [`align`]: a_z = c0 + G·r(2πΩ)²·f''(2πΩ(t − t_mid − t_p)) on the fit window, in
+/// p = (c0, G, Ω, t_p − t_mid), with its analytic Jacobian.
+struct CrankWindow<'a> {
+    t: &'a [f64],
+    az: &'a [f64],
+    idx: &'a [usize],
+    r: f64,
+    lambda: f64,
+    t_mid: f64,
+}
+
+impl CrankWindow<'_> {
+    /// The model at `ti` and its gradient in p.
+    fn model(&self, p: &[f64], ti: f64) -> (f64, [f64; 4]) {
+        let two_pi = 2.0 * std::f64::consts::PI;
+        let (c0, g, om, tp) = (p[0], p[1], p[2], p[3]);
+        let kk = self.r * (two_pi * om).powi(2);
+        let dt = ti - self.t_mid - tp;
+        let phi = two_pi * om * dt;
+        let f2 = crank_f2(phi, self.lambda);
+        let d3 = f3(phi, self.lambda);
+        let val = c0 + g * kk * f2;
+        let j = [
+            1.0,
+            kk * f2,
+            g * (2.0 * kk / om * f2 + kk * d3 * two_pi * dt),
+            -g * kk * d3 * two_pi * om,
+        ];
+        (val, j)
+    }
+}
+
+impl LeastSquaresProblem for CrankWindow<'_> {
+    fn dim(&self) -> usize {
+        4
+    }
+    fn bounds(&self) -> Vec<(f64, f64)> {
+        vec![(f64::NEG_INFINITY, f64::INFINITY); 4]
+    }
+    fn residuals(&self, p: &[f64]) -> Option<Vec<f64>> {
+        let r = self
+            .idx
+            .iter()
+            .map(|&i| self.az[i] - self.model(p, self.t[i]).0);
+        Some(r.collect())
+    }
+    fn jacobian(&self, p: &[f64], _r: &[f64]) -> Option<Vec<Vec<f64>>> {
+        let mut cols: Vec<Vec<f64>> = (0..4).map(|_| Vec::with_capacity(self.idx.len())).collect();
+        for &i in self.idx {
+            let (_, j) = self.model(p, self.t[i]);
+            for (c, v) in cols.iter_mut().zip(j) {
+                c.push(-v);
+            }
+        }
+        Some(cols)
+    }
+}
+
+/// One block of [`track_crank_phase`]: a_z = c0 + G·r·ω²·f''(ψ + ω(t − tc)) on samples `range`,
+/// in p = [ψ, ω, G, c0], with its analytic Jacobian.
+struct CrankBlock<'a> {
+    t: &'a [f64],
+    az: &'a [f64],
+    range: std::ops::Range<usize>,
+    tc: f64,
+    r: f64,
+    lambda: f64,
+}
+
+impl LeastSquaresProblem for CrankBlock<'_> {
+    fn dim(&self) -> usize {
+        4
+    }
+    fn bounds(&self) -> Vec<(f64, f64)> {
+        vec![(f64::NEG_INFINITY, f64::INFINITY); 4]
+    }
+    fn residuals(&self, p: &[f64]) -> Option<Vec<f64>> {
+        let model = |i: usize| {
+            let phi = p[0] + p[1] * (self.t[i] - self.tc);
+            p[3] + p[2] * self.r * p[1] * p[1] * crank_f2(phi, self.lambda)
+        };
+        Some(self.range.clone().map(|i| self.az[i] - model(i)).collect())
+    }
+    fn jacobian(&self, p: &[f64], _r: &[f64]) -> Option<Vec<Vec<f64>>> {
+        let mut cols: Vec<Vec<f64>> = (0..4)
+            .map(|_| Vec::with_capacity(self.range.len()))
+            .collect();
+        for i in self.range.clone() {
+            let dt = self.t[i] - self.tc;
+            let phi = p[0] + p[1] * dt;
+            let f2 = crank_f2(phi, self.lambda);
+            let d_psi = p[2] * self.r * p[1] * p[1] * f3(phi, self.lambda);
+            let j = [
+                d_psi,
+                d_psi * dt + 2.0 * p[2] * self.r * p[1] * f2,
+                self.r * p[1] * p[1] * f2,
+                1.0,
+            ];
+            for (c, v) in cols.iter_mut().zip(j) {
+                c.push(-v);
+            }
+        }
+        Some(cols)
+    }
+}
+
+/// [`fit_speed_drift`]'s model a_z = c0 + G·r·[(2πΩ(τ))² f''(φ) + 2π(dΩ/dτ) f'(φ)] on samples
+/// `idx`, in p = [c0, G, Ω0 (Hz), dΩ/dτ (Hz/s), δ (s)], τ = t − t0 − δ.
+struct DriftProblem<'a> {
+    t: &'a [f64],
+    az: &'a [f64],
+    idx: &'a [usize],
+    t0: f64,
+    r: f64,
+    lambda: f64,
+}
+
+impl DriftProblem<'_> {
+    fn model(&self, p: &[f64], ti: f64) -> f64 {
+        let two_pi = 2.0 * std::f64::consts::PI;
+        let tau = ti - self.t0 - p[4];
+        let phi = two_pi * (p[2] * tau + 0.5 * p[3] * tau * tau);
+        let rate = two_pi * (p[2] + p[3] * tau);
+        p[0] + p[1]
+            * self.r
+            * (rate * rate * crank_f2(phi, self.lambda)
+                + two_pi * p[3] * crank_f1(phi, self.lambda))
+    }
+}
+
+impl LeastSquaresProblem for DriftProblem<'_> {
+    fn dim(&self) -> usize {
+        5
+    }
+    fn bounds(&self) -> Vec<(f64, f64)> {
+        vec![(f64::NEG_INFINITY, f64::INFINITY); 5]
+    }
+    fn residuals(&self, p: &[f64]) -> Option<Vec<f64>> {
+        Some(
+            self.idx
+                .iter()
+                .map(|&i| self.az[i] - self.model(p, self.t[i]))
+                .collect(),
+        )
+    }
+    /// Central differences of the model itself with fixed steps (not of a_z − model, which
+    /// would put the data into the cancellation).
+    fn jacobian(&self, p: &[f64], _r: &[f64]) -> Option<Vec<Vec<f64>>> {
+        let steps = [1e-4, 1e-7, 1e-8, 1e-8, 1e-7];
+        let mut cols: Vec<Vec<f64>> = (0..5).map(|_| Vec::with_capacity(self.idx.len())).collect();
+        for &i in self.idx {
+            for (k, col) in cols.iter_mut().enumerate() {
+                let (mut hi, mut lo) = ([0.0; 5], [0.0; 5]);
+                hi.copy_from_slice(p);
+                lo.copy_from_slice(p);
+                hi[k] += steps[k];
+                lo[k] -= steps[k];
+                let d = self.model(&hi, self.t[i]) - self.model(&lo, self.t[i]);
+                col.push(-d / (2.0 * steps[k]));
+            }
+        }
+        Some(cols)
+    }
 }
