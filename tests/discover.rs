@@ -401,9 +401,17 @@ fn regression_issue_5_finds_dry_torque_and_position_torque_together() {
 #[test]
 fn issue_14_second_look_names_the_breakaway_not_a_constant_dry_torque() {
     let (truth, spec, base, a, b, mu) = draw("stribeck", &mut rng(14_000));
-    eprintln!("hidden stribeck: {truth:.4e} ({spec}), base {}", base.name());
+    eprintln!(
+        "hidden stribeck: {truth:.4e} ({spec}), base {}",
+        base.name()
+    );
     let s = discover(14_001, base, a, b, mu, &spec);
-    assert_eq!(s.discovery.accepted(), vec!["stribeck"], "{}", s.discovery);
+    assert_eq!(
+        s.discovery.accepted(),
+        vec!["stribeck"],
+        "{:#?}",
+        s.discovery.rows
+    );
     let row = s
         .discovery
         .rows
