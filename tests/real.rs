@@ -393,7 +393,9 @@ fn multiarm_identify_free_decay() {
         "{text}"
     );
     let (params, runs) = (joint.join("params.parquet"), joint.join("runs.parquet"));
-    assert_eq!(column_str(&params, "excitation"), ["none"]);
+    // The shared fit first, then each run's own (their ω0 differ by 1.3 %: issue 16).
+    assert_eq!(column_str(&params, "scope"), ["shared", "run", "run"]);
+    assert_eq!(column_str(&params, "excitation"), ["none"; 3]);
     assert!(!column_str(&params, "not_separable")[0].is_empty());
     for unknown in ["a", "b", "mu", "R", "omega", "omega_hz", "crank_r_m"] {
         assert!(column_f64(&params, unknown)[0].is_nan(), "{unknown}");
