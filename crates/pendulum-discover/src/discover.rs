@@ -73,6 +73,7 @@ impl Default for DiscoverConfig {
                     sample_hz: 100.0,
                     segment_s: Some(0.5),
                     t_sim_s: None,
+                    free_window_s: None,
                 },
                 sim_tol: 1e-6,
                 ..ValidateConfig::default()

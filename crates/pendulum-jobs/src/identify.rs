@@ -128,6 +128,7 @@ fn apply_overrides(p: &mut PipelineConfig, o: &FitOverrides) {
         }
         if let Some(w) = o.window_s {
             fit.window.window_s = w;
+            fit.window.free_window_s = Some(w);
         }
         if o.no_early_abandon {
             fit.early_abandon = false;
@@ -137,6 +138,7 @@ fn apply_overrides(p: &mut PipelineConfig, o: &FitOverrides) {
         for s in &mut p.stages {
             if let StageConfig::Validate(v) = s {
                 v.window.window_s = w;
+                v.window.free_window_s = Some(w);
             }
         }
     }

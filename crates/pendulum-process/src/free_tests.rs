@@ -110,6 +110,7 @@ fn fit_linear_plus(
         sample_hz: 100.0,
         segment_s: Some(0.5),
         t_sim_s: None,
+        free_window_s: Some(10.0),
     };
     let prepared = prepare_run(run, al, ic, steady, &steady_cfg, &window).expect("prepare");
     let cfg = FitConfig {
@@ -176,6 +177,7 @@ fn regression_issue_16_params_at_bounds_are_reported() {
         sample_hz: 100.0,
         segment_s: Some(0.5),
         t_sim_s: None,
+        free_window_s: Some(10.0),
     };
     let prepared =
         crate::identify::prepare_run(&run, &al, &ic, &steady, &steady_cfg, &window).unwrap();
@@ -210,6 +212,7 @@ fn regression_issue_16_shared_omega0_is_warned() {
         sample_hz: 100.0,
         segment_s: Some(0.5),
         t_sim_s: None,
+        free_window_s: Some(10.0),
     };
     let steady_cfg = SteadyConfig::default();
     let prepare = |run: &RunData| {
@@ -390,6 +393,7 @@ fn regression_issue_16_identify_reaches_one_decay_law() {
         sample_hz: 100.0,
         segment_s: Some(0.5),
         t_sim_s: None,
+        free_window_s: Some(10.0),
     };
     let prepared = prepare_run(&run, &al, &ic, &steady, &steady_cfg, &window).expect("prepare");
     let cfg = FitConfig {

@@ -35,6 +35,14 @@ pub struct Window {
     /// `None` = to the end of the capture, classified over the same tail as the measurement.
     #[serde(default)]
     pub t_sim_s: Option<f64>,
+    /// A free decay's fit window after t = 0, s; `None` = the whole decay, up to where its
+    /// measured rest (or last stretch) starts. A decay's law shows across its amplitudes: a
+    /// 10 s window on a 55 s recording (MultiArm's `large`) saw only swings of 1.20–1.57 rad,
+    /// where the envelope resolves viscous and quadratic drag, while the whole recording
+    /// resolves quadratic drag and dry friction clear of zero (issue 16). `--window-s` sets it
+    /// too.
+    #[serde(default)]
+    pub free_window_s: Option<f64>,
 }
 
 impl Default for Window {
@@ -44,6 +52,18 @@ impl Default for Window {
             sample_hz: 100.0,
             segment_s: None,
             t_sim_s: None,
+            free_window_s: None,
+        }
+    }
+}
+
+impl Window {
+    /// The fit window after t = 0 for a run, s (`free`: a free decay).
+    pub fn span_s(&self, free: bool) -> f64 {
+        if free {
+            self.free_window_s.unwrap_or(f64::INFINITY)
+        } else {
+            self.window_s
         }
     }
 }
@@ -83,9 +103,9 @@ pub fn prepare_run(
     // A free decay shorter than window + tail (the free segment before a shaker starts) ends
     // its window where its tail starts, so that the tail is simulated beyond the window.
     let window_end = if al.is_free() && window.t_sim_s.is_none() {
-        (al.t0_s + window.window_s).min(from)
+        (al.t0_s + window.span_s(true)).min(from)
     } else {
-        al.t0_s + window.window_s
+        al.t0_s + window.span_s(al.is_free())
     };
     let hi = t.partition_point(|&x| x <= window_end);
     if hi <= lo + 10 {
@@ -125,7 +145,7 @@ pub fn prepare_run(
     } else {
         window.segment_s
     };
-    if let Some(seg) = segment_s.filter(|s| *s > 0.0 && *s < window.window_s) {
+    if let Some(seg) = segment_s.filter(|s| *s > 0.0 && *s < window.span_s(al.is_free())) {
         let ic_cfg = IcConfig::default();
         let mut k = 1;
         loop {
