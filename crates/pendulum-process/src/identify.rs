@@ -508,11 +508,15 @@ pub fn params_at_bounds(runs: &[PreparedRun], out: &FitOutcome) -> Vec<String> {
                 p.unit()
             )
         };
+        // A dimensionless ratio's unit is "1": the number alone reads better.
+        let unit = match p.unit() {
+            "1" | "" => String::new(),
+            u => format!(" {u}"),
+        };
         notes.push(format!(
-            "fit {}: {} = {v:.4e} {} sits at its {side} bound {b:.4}: {what}",
+            "fit {}: {} = {v:.4e}{unit} sits at its {side} bound {b:.4}: {what}",
             out.spec.name,
             p.name(),
-            p.unit()
         ));
     }
     notes
