@@ -195,6 +195,34 @@ fn regression_issue_5_finds_position_torque() {
     assert_found(&s, "position_torque", tp, 0.25, 0.0);
 }
 
+/// effects.md's position torque includes "cogging of a coupled motor (k large)". discover screened
+/// k ≤ 4 only, and a hidden k = 8 cogging (0.03 N·m) came out as `unexplained` (θ mod 2π) with
+/// nothing named. Now k is screened up to 24; here k, T_p, φ_p and the design are drawn.
+#[test]
+fn regression_issue_12_finds_motor_cogging() {
+    let mut r = rng(12_024);
+    let k: u32 = r.random_range(6..=24);
+    let tp = r.random_range(0.015..0.04);
+    let phi = r.random_range(-3.0..3.0);
+    let s = discover(
+        12_024,
+        Base::Reference,
+        0.0,
+        r.random_range(0.3..0.7),
+        r.random_range(0.08..0.2),
+        &format!("position_torque = {{ t_p_nm = {tp}, k = {k}, phi_p_rad = {phi} }}"),
+    );
+    eprintln!("hidden cogging: T_p {tp:.4e} N·m, k = {k}, φ_p {phi:.3}");
+    assert_found(&s, "position_torque", tp, 0.1, 0.0);
+    let row = s
+        .discovery
+        .rows
+        .iter()
+        .find(|r| r.effect == "position_torque")
+        .unwrap();
+    assert!(row.note.starts_with(&format!("k = {k};")), "{}", row.note);
+}
+
 #[test]
 fn regression_issue_5_finds_horizontal_base() {
     found_when_hidden("horizontal_base", 6, 123);

@@ -6,58 +6,36 @@ use crate::{Dimensionless, Physical};
 #[derive(Debug)]
 pub struct PositionTorque;
 
-/// Discover's columns: sin kθ and cos kθ for k = 1…4, one candidate per k
+/// The largest lobe count discover screens: effects.md's position torque includes "cogging of a
+/// coupled motor (k large)"; small motors' cogging periods run to a few dozen per turn (slots ×
+/// poles over their common factors), while the encoder's 4096 counts resolve a lobe of 2π/24
+/// with 170 counts.
+const K_MAX: u32 = 24;
+
+/// Two columns per lobe count k: T_p sin(kθ + φ_p) = a sin kθ + b cos kθ.
+macro_rules! lobes {
+    ($($k:literal)*) => {
+        [$(
+            Regressor {
+                name: concat!("pos", stringify!($k), "_sin"),
+                group: $k,
+                term: |s| ($k as f64 * s.theta).sin(),
+                per_si: TORQUE,
+            },
+            Regressor {
+                name: concat!("pos", stringify!($k), "_cos"),
+                group: $k,
+                term: |s| ($k as f64 * s.theta).cos(),
+                per_si: TORQUE,
+            },
+        )*]
+    };
+}
+
+/// Discover's columns: sin kθ and cos kθ for k = 1…[`K_MAX`], one candidate per k
 /// (p = T_p/(m g l)).
-static REGRESSORS: [Regressor; 8] = [
-    Regressor {
-        name: "pos1_sin",
-        group: 1,
-        term: |s| s.theta.sin(),
-        per_si: TORQUE,
-    },
-    Regressor {
-        name: "pos1_cos",
-        group: 1,
-        term: |s| s.theta.cos(),
-        per_si: TORQUE,
-    },
-    Regressor {
-        name: "pos2_sin",
-        group: 2,
-        term: |s| (2.0 * s.theta).sin(),
-        per_si: TORQUE,
-    },
-    Regressor {
-        name: "pos2_cos",
-        group: 2,
-        term: |s| (2.0 * s.theta).cos(),
-        per_si: TORQUE,
-    },
-    Regressor {
-        name: "pos3_sin",
-        group: 3,
-        term: |s| (3.0 * s.theta).sin(),
-        per_si: TORQUE,
-    },
-    Regressor {
-        name: "pos3_cos",
-        group: 3,
-        term: |s| (3.0 * s.theta).cos(),
-        per_si: TORQUE,
-    },
-    Regressor {
-        name: "pos4_sin",
-        group: 4,
-        term: |s| (4.0 * s.theta).sin(),
-        per_si: TORQUE,
-    },
-    Regressor {
-        name: "pos4_cos",
-        group: 4,
-        term: |s| (4.0 * s.theta).cos(),
-        per_si: TORQUE,
-    },
-];
+static REGRESSORS: [Regressor; 2 * K_MAX as usize] =
+    lobes!(1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24);
 
 const TORQUE: fn(&Physical) -> f64 = |p| 1.0 / (p.m_kg * p.g_m_s2 * p.l_m);
 
@@ -119,7 +97,7 @@ impl Effect for PositionTorque {
             base: "reference",
             draws: &[
                 ("position_torque.T_p", Draw::Uniform(0.015, 0.04)),
-                ("position_torque.k", Draw::Int(1, 4)),
+                ("position_torque.k", Draw::Int(1, K_MAX as i32)),
                 ("position_torque.phi_p", Draw::Uniform(-3.0, 3.0)),
             ],
         }
