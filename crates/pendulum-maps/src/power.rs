@@ -115,31 +115,13 @@ pub fn nan_powers() -> MeanPowers {
 
 /// The mean of several starts' powers, field by field.
 pub fn mean_of(p: &[MeanPowers]) -> MeanPowers {
-    let n = p.len().max(1) as f64;
     let mut m = MeanPowers::default();
     for x in p {
-        m.base += x.base;
-        m.viscous += x.viscous;
-        m.quadratic += x.quadratic;
-        m.dry += x.dry;
-        m.generator += x.generator;
-        m.load += x.load;
-        m.diodes += x.diodes;
-        m.stored += x.stored;
+        for (sum, v) in m.fields_mut().into_iter().zip(x.named()) {
+            *sum += v.1;
+        }
     }
-    for v in [
-        &mut m.base,
-        &mut m.viscous,
-        &mut m.quadratic,
-        &mut m.dry,
-        &mut m.generator,
-        &mut m.load,
-        &mut m.diodes,
-        &mut m.stored,
-    ] {
-        *v /= n;
-    }
-    m
+    m.scaled(1.0 / p.len().max(1) as f64)
 }
 
 /// Sample standard deviation (n − 1) of `v`; 0 for fewer than two values.

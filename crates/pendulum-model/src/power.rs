@@ -60,16 +60,30 @@ impl MeanPowers {
 
     /// The same in W, for the rig of power scale `m g l ω0` W ([`crate::Physical::power_scale_w`]).
     pub fn si(&self, scale_w: f64) -> Self {
-        Self {
-            base: self.base * scale_w,
-            viscous: self.viscous * scale_w,
-            quadratic: self.quadratic * scale_w,
-            dry: self.dry * scale_w,
-            generator: self.generator * scale_w,
-            load: self.load * scale_w,
-            diodes: self.diodes * scale_w,
-            stored: self.stored * scale_w,
+        self.scaled(scale_w)
+    }
+
+    /// Every field times `f` (all are powers on one scale).
+    pub fn scaled(&self, f: f64) -> Self {
+        let mut m = *self;
+        for v in m.fields_mut() {
+            *v *= f;
         }
+        m
+    }
+
+    /// Every field, in [`MeanPowers::named`]'s order, for field-wise arithmetic (sums, means).
+    pub fn fields_mut(&mut self) -> [&mut f64; 8] {
+        [
+            &mut self.base,
+            &mut self.viscous,
+            &mut self.quadratic,
+            &mut self.dry,
+            &mut self.generator,
+            &mut self.load,
+            &mut self.diodes,
+            &mut self.stored,
+        ]
     }
 
     /// (name, value) in a fixed order, for tables and metadata.
@@ -148,18 +162,7 @@ pub fn mean_powers(
         ControlFlow::Continue(())
     })?;
     let span = t_to - t_from;
-    let mut m = acc;
-    for v in [
-        &mut m.base,
-        &mut m.viscous,
-        &mut m.quadratic,
-        &mut m.dry,
-        &mut m.generator,
-        &mut m.load,
-        &mut m.diodes,
-    ] {
-        *v /= span;
-    }
+    let mut m = acc.scaled(1.0 / span);
     m.stored = (e_to - e_from) / span;
     Ok(m)
 }
