@@ -47,7 +47,9 @@
 use std::fmt;
 use std::ops::ControlFlow;
 
-use pendulum_model::{integrate, Dimensionless, Excitation, Model, ModelError, SimOptions};
+use pendulum_model::{
+    integrate, Dimensionless, Excitation, FreeDecay, Model, ModelError, SimOptions,
+};
 use serde::{Deserialize, Serialize};
 
 use pendulum_numerics::{bic, inverse_spd, median, solve_spd, LsFit};
@@ -85,6 +87,18 @@ pub enum Term {
     Stiffness,
 }
 
+/// The stiffness is a departure, not a catalogue effect (a torsion spring beside gravity): its
+/// definition lives here.
+static STIFFNESS: FreeDecay = FreeDecay {
+    symbol: "kappa",
+    unit: "1",
+    meaning: "kappa = k/(m g a) = k/(I omega_g^2): restoring torque -k theta beside gravity \
+              (omega_n^2 = omega_g^2 (1 + kappa))",
+    friction: |_, _| 0.0,
+    set: |d, v| d.kappa = v,
+    fd_floor: 1e-6,
+};
+
 impl Term {
     /// Every term, in catalogue order.
     pub const ALL: [Term; 4] = [
@@ -105,67 +119,40 @@ impl Term {
         }
     }
 
+    /// Its definition: the catalogue effect's [`FreeDecay`] (the stiffness's own, here).
+    fn def(self) -> &'static FreeDecay {
+        pendulum_model::effects::by_name(self.name())
+            .and_then(|e| e.free_decay())
+            .unwrap_or(&STIFFNESS)
+    }
+
     /// The dimensionless parameter's symbol.
     pub fn symbol(self) -> &'static str {
-        match self {
-            Term::ViscousLinear => "beta",
-            Term::CoulombConstant => "c",
-            Term::ViscousQuadratic => "alpha",
-            Term::CoulombBearing => "M",
-            Term::Stiffness => "kappa",
-        }
+        self.def().symbol
     }
 
     /// Unit of the dimensionless parameter (as reported).
     pub fn unit(self) -> &'static str {
-        match self {
-            Term::ViscousLinear => "1",
-            Term::CoulombConstant => "rad",
-            Term::ViscousQuadratic => "1/rad",
-            Term::CoulombBearing => "1",
-            Term::Stiffness => "1",
-        }
+        self.def().unit
     }
 
     /// What the parameter is.
     pub fn meaning(self) -> &'static str {
-        match self {
-            Term::ViscousLinear => "beta = gamma/omega_n, gamma = viscous torque coefficient / I",
-            Term::CoulombConstant => {
-                "c = T_c/(I omega_n^2) = T_c/(m g a): dry-friction dead-band half-width"
-            }
-            Term::ViscousQuadratic => "alpha = q: quadratic drag torque / (I theta_dot^2)",
-            Term::CoulombBearing => {
-                "M = mu r_b m g/(I omega_n^2) (load N = |theta'^2 + cos theta|)"
-            }
-            Term::Stiffness => {
-                "kappa = k/(m g a) = k/(I omega_g^2): restoring torque -k theta beside gravity \
-                 (omega_n^2 = omega_g^2 (1 + kappa))"
-            }
-        }
+        self.def().meaning
     }
 
-    /// Dry friction (stick/slip) terms.
+    /// Dry friction (stick/slip) terms: those that set the sticking capacity.
     pub fn is_dry(self) -> bool {
-        matches!(self, Term::CoulombConstant | Term::CoulombBearing)
+        pendulum_model::effects::by_name(self.name()).is_some_and(|e| e.sets_sticking_capacity())
     }
 
     fn set(self, d: &mut Dimensionless, v: f64) {
-        match self {
-            Term::ViscousLinear => d.beta = v,
-            Term::CoulombConstant => d.c = v,
-            Term::ViscousQuadratic => d.alpha = v,
-            Term::CoulombBearing => d.m_coulomb = v,
-            Term::Stiffness => d.kappa = v,
-        }
+        (self.def().set)(d, v)
     }
 
     /// Finite-difference step floor.
     fn fd_floor(self) -> f64 {
-        match self {
-            Term::ViscousLinear | Term::ViscousQuadratic | Term::Stiffness => 1e-6,
-            Term::CoulombConstant | Term::CoulombBearing => 1e-7,
-        }
+        self.def().fd_floor
     }
 
     /// Loss of amplitude per cycle at amplitude `a` (rad) per unit of the parameter, for the
@@ -184,15 +171,10 @@ impl Term {
         }
         let a = a.clamp(1e-9, std::f64::consts::PI - 1e-3);
         let ca = a.cos();
+        let friction = self.def().friction;
         let f = |th: f64| -> f64 {
             let w2 = (2.0 * (th.cos() - ca) + kappa * (a * a - th * th)).max(0.0);
-            match self {
-                Term::CoulombConstant => 1.0,
-                Term::ViscousLinear => w2.sqrt(),
-                Term::ViscousQuadratic => w2,
-                Term::CoulombBearing => (w2 + th.cos()).abs(),
-                Term::Stiffness => 0.0,
-            }
+            friction(th, w2)
         };
         // θ = A sin φ removes the square-root end points; Simpson on φ ∈ [−π/2, π/2].
         let n = 64;
@@ -3091,6 +3073,26 @@ impl fmt::Display for DecayDiagnosis {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The decay's terms are the catalogue's: every effect that defines how it shows in a free
+    /// decay is a term (in catalogue order), and every term but the stiffness (a departure) is
+    /// such an effect.
+    #[test]
+    fn decay_terms_are_the_catalogues() {
+        let from_catalogue: Vec<&str> = pendulum_model::CATALOGUE
+            .iter()
+            .filter(|e| e.free_decay().is_some())
+            .map(|e| e.name())
+            .collect();
+        let mut terms: Vec<&str> = Term::ALL.iter().map(|t| t.name()).collect();
+        let order = |n: &&str| from_catalogue.iter().position(|c| c == n);
+        terms.sort_by_key(order);
+        assert_eq!(terms, from_catalogue);
+        assert!(pendulum_model::effects::by_name(Term::Stiffness.name()).is_none());
+        assert_eq!(Term::Stiffness.symbol(), "kappa");
+        assert!(Term::CoulombConstant.is_dry() && Term::CoulombBearing.is_dry());
+        assert!(!Term::ViscousLinear.is_dry() && !Term::Stiffness.is_dry());
+    }
 
     #[test]
     fn loss_curves_match_small_amplitude_limits() {

@@ -13,7 +13,8 @@ pub mod steady;
 mod physics_tests;
 
 pub use effects::{
-    Effect, EffectParam, RateShape, Regressor, Sensors, Tolerance, Variable, WeakSample, CATALOGUE,
+    Effect, EffectParam, FreeDecay, RateShape, Regressor, Sensors, Tolerance, Variable, WeakSample,
+    CATALOGUE,
 };
 pub use excitation::{CrankDrive, CrankTable, Excitation, MeasuredAccel};
 pub use params::{Dimensionless, Effects, Physical};

@@ -1,6 +1,6 @@
 //! `coulomb_bearing`: the reference model's load-proportional dry friction μ r_b F_N sgn θ'.
 
-use super::{Decompiled, Draw, Effect, Kind, Param, Regressor, Survey};
+use super::{Decompiled, Draw, Effect, FreeDecay, Kind, Param, Regressor, Survey};
 use crate::{Dimensionless, Physical};
 
 #[derive(Debug)]
@@ -17,7 +17,20 @@ static REGRESSORS: [Regressor; 1] = [Regressor {
 
 static PARAMS: [Param; 1] = [Param::real("mu", "mu", "1", (0.0, 0.25))];
 
+/// In a free decay (`pendulum-explain`).
+static FREE_DECAY: FreeDecay = FreeDecay {
+    symbol: "M",
+    unit: "1",
+    meaning: "M = mu r_b m g/(I omega_n^2) (load N = |theta'^2 + cos theta|)",
+    friction: |th, w2| (w2 + th.cos()).abs(),
+    set: |d, v| d.m_coulomb = v,
+    fd_floor: 1e-7,
+};
+
 impl Effect for CoulombBearing {
+    fn free_decay(&self) -> Option<&'static FreeDecay> {
+        Some(&FREE_DECAY)
+    }
     fn positive(&self) -> bool {
         true
     }

@@ -1,6 +1,6 @@
 //! `coulomb_constant`: a load-independent dry torque T_c sgn θ' (seals, a belt-coupled motor).
 
-use super::{Decompiled, Draw, Effect, Kind, Param, Regressor, Survey, Variable};
+use super::{Decompiled, Draw, Effect, FreeDecay, Kind, Param, Regressor, Survey, Variable};
 use crate::{Dimensionless, Physical};
 
 #[derive(Debug)]
@@ -21,7 +21,20 @@ static PARAMS: [Param; 1] = [Param::real(
     (0.0, 0.05),
 )];
 
+/// In a free decay (`pendulum-explain`).
+static FREE_DECAY: FreeDecay = FreeDecay {
+    symbol: "c",
+    unit: "rad",
+    meaning: "c = T_c/(I omega_n^2) = T_c/(m g a): dry-friction dead-band half-width",
+    friction: |_, _| 1.0,
+    set: |d, v| d.c = v,
+    fd_floor: 1e-7,
+};
+
 impl Effect for CoulombConstant {
+    fn free_decay(&self) -> Option<&'static FreeDecay> {
+        Some(&FREE_DECAY)
+    }
     fn positive(&self) -> bool {
         true
     }

@@ -272,6 +272,27 @@ pub enum Decompiled {
     Set(Option<Vec<f64>>),
 }
 
+/// How a damping effect shows in a free decay (no shaker), for `pendulum-explain`'s decay
+/// analysis: its dimensionless parameter on the decay's own scale (the torque over I ω_n² =
+/// m g a, a the pivot-to-centre-of-mass distance, time in 1/ω_n) and the friction torque it adds
+/// per unit of that parameter.
+#[derive(Debug)]
+pub struct FreeDecay {
+    /// The parameter's symbol in the decay's tables.
+    pub symbol: &'static str,
+    /// Its unit, as reported.
+    pub unit: &'static str,
+    /// What the parameter is, in words.
+    pub meaning: &'static str,
+    /// |friction torque| per unit parameter at angle θ with θ'² = `w2` (a free pendulum): the
+    /// integrand of the energy it takes over a half swing.
+    pub friction: fn(theta: f64, w2: f64) -> f64,
+    /// Sets the parameter in the simulator's parameters.
+    pub set: fn(&mut Dimensionless, f64),
+    /// Finite-difference step floor of its fit.
+    pub fd_floor: f64,
+}
+
 /// One effect of `effects.md`. Implementations are unit structs in this folder.
 pub trait Effect: Sync + std::fmt::Debug {
     /// The stable name of `effects.md`; outputs use exactly this string.
@@ -288,6 +309,11 @@ pub trait Effect: Sync + std::fmt::Debug {
 
     /// Another way to give its parameters (see [`Alternative`]); stored and written in its own.
     fn alternative(&self) -> Option<&'static Alternative> {
+        None
+    }
+
+    /// How it shows in a free decay (`None`: not a damping term a decay can resolve).
+    fn free_decay(&self) -> Option<&'static FreeDecay> {
         None
     }
 

@@ -1,6 +1,6 @@
 //! `viscous_linear`: the reference model's linear drag b l² θ'.
 
-use super::{Decompiled, Draw, Effect, Kind, Param, Regressor, Survey, Variable};
+use super::{Decompiled, Draw, Effect, FreeDecay, Kind, Param, Regressor, Survey, Variable};
 use crate::{Dimensionless, Physical};
 
 #[derive(Debug)]
@@ -16,7 +16,20 @@ static REGRESSORS: [Regressor; 1] = [Regressor {
 
 static PARAMS: [Param; 1] = [Param::real("b", "b_n_s_m", "N·s/m", (0.0, 1.0))];
 
+/// In a free decay (`pendulum-explain`).
+static FREE_DECAY: FreeDecay = FreeDecay {
+    symbol: "beta",
+    unit: "1",
+    meaning: "beta = gamma/omega_n, gamma = viscous torque coefficient / I",
+    friction: |_, w2| w2.sqrt(),
+    set: |d, v| d.beta = v,
+    fd_floor: 1e-6,
+};
+
 impl Effect for ViscousLinear {
+    fn free_decay(&self) -> Option<&'static FreeDecay> {
+        Some(&FREE_DECAY)
+    }
     fn positive(&self) -> bool {
         true
     }

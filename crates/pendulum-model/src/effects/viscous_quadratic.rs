@@ -1,6 +1,6 @@
 //! `viscous_quadratic`: the reference model's quadratic drag a l³ θ'|θ'|.
 
-use super::{Decompiled, Draw, Effect, Kind, Param, Regressor, Survey, Variable};
+use super::{Decompiled, Draw, Effect, FreeDecay, Kind, Param, Regressor, Survey, Variable};
 use crate::{Dimensionless, Physical};
 
 #[derive(Debug)]
@@ -16,7 +16,20 @@ static REGRESSORS: [Regressor; 1] = [Regressor {
 
 static PARAMS: [Param; 1] = [Param::real("a", "a_kg_m", "kg/m", (0.0, 1.0))];
 
+/// In a free decay (`pendulum-explain`).
+static FREE_DECAY: FreeDecay = FreeDecay {
+    symbol: "alpha",
+    unit: "1/rad",
+    meaning: "alpha = q: quadratic drag torque / (I theta_dot^2)",
+    friction: |_, w2| w2,
+    set: |d, v| d.alpha = v,
+    fd_floor: 1e-6,
+};
+
 impl Effect for ViscousQuadratic {
+    fn free_decay(&self) -> Option<&'static FreeDecay> {
+        Some(&FREE_DECAY)
+    }
     fn positive(&self) -> bool {
         true
     }
