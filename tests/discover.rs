@@ -197,11 +197,11 @@ fn regression_issue_5_finds_position_torque() {
 
 /// effects.md's position torque includes "cogging of a coupled motor (k large)". discover screened
 /// k ≤ 4 only, and a hidden k = 8 cogging (0.03 N·m) came out as `unexplained` (θ mod 2π) with
-/// nothing named. Now k is screened up to 24; here k, T_p, φ_p and the design are drawn.
+/// nothing named. Now k is screened up to 64; here k, T_p, φ_p and the design are drawn.
 #[test]
 fn regression_issue_12_finds_motor_cogging() {
     let mut r = rng(12_024);
-    let k: u32 = r.random_range(6..=24);
+    let k: u32 = r.random_range(6..=64);
     let tp = r.random_range(0.015..0.04);
     let phi = r.random_range(-3.0..3.0);
     let s = discover(

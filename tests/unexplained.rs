@@ -126,3 +126,53 @@ fn regression_issue_14_mislabelled_encoder_is_unexplained() {
         }
     }
 }
+
+/// A dry torque that grows as the rig runs (a bearing heating up, a seal drying out: T_c = r·t
+/// from the capture's start, sgn θ'). A constant dry torque fits its mean, but the runs disagree
+/// on it by when their windows fall. The answer must be `unexplained`, following time, "a
+/// friction growing with time", and nothing named. Its rate (the t sgn θ̇ term) is reported, not
+/// promised within 10 %: on these two draws it came out +0.1 % and −29.8 % (that one 2.4 of its
+/// standard errors off: the overlapping windows' errors are correlated, so the regression's
+/// interval understates its scatter); the test holds it within a factor of two.
+#[test]
+fn regression_issue_12_growing_dry_torque_is_unexplained() {
+    let mut r = rng(3);
+    for case in 0..2 {
+        let rate = r.random_range(2e-4..4e-4);
+        let (b, mu) = (r.random_range(0.3..0.7), r.random_range(0.08..0.2));
+        let s = discover_with(
+            7300 + case,
+            b,
+            mu,
+            &format!("dry_torque_growth_nm_per_s = {rate}"),
+        );
+        let d = &s.discovery;
+        assert!(
+            d.accepted().is_empty(),
+            "case {case}: named {:?} for a growing dry torque",
+            d.accepted()
+        );
+        let desc = d
+            .unexplained_description
+            .as_ref()
+            .unwrap_or_else(|| panic!("case {case}: no description ({:?})", d.unexplained));
+        assert_eq!(desc.variable, Variable::Time, "case {case}: {desc:?}");
+        let growth = desc
+            .terms
+            .iter()
+            .find(|(j, _, _)| LIBRARY[*j].name == "t sgn θ̇")
+            .unwrap_or_else(|| panic!("case {case}: no t sgn θ̇ term in {desc:?}"));
+        eprintln!(
+            "case {case}: growth {rate:.4e} N·m/s described as {:.4e} ({:+.1} %)",
+            growth.1,
+            100.0 * (growth.1 / rate - 1.0)
+        );
+        assert!(
+            growth.1 > 0.5 * rate && growth.1 < 2.0 * rate,
+            "case {case}: growth {rate:.4e} N·m/s described as {:.4e}",
+            growth.1
+        );
+        let words = d.unexplained.as_deref().unwrap_or_default();
+        assert!(words.contains("growing with time"), "{words}");
+    }
+}

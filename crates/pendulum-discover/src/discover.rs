@@ -270,34 +270,8 @@ impl View {
     /// (as its initial state is for E_θ): it is a nuisance of the run, not a prediction of the
     /// model.
     fn sq_val(&self, fit: &crate::screen::Ols) -> Vec<f64> {
-        let rows = &self.val_rows;
-        let mut res = fit.residuals(rows);
-        let runs: std::collections::BTreeSet<usize> = rows.iter().map(|r| r.run).collect();
-        let Some(offset) = crate::weak::observation_column() else {
-            return res
-                .iter()
-                .zip(rows)
-                .map(|(e, r)| r.weight * e * e)
-                .collect();
-        };
-        for run in runs {
-            let idx: Vec<usize> = (0..rows.len()).filter(|&i| rows[i].run == run).collect();
-            let (mut sxy, mut sxx) = (0.0, 0.0);
-            for &i in &idx {
-                let (x, w) = (rows[i].x[offset], rows[i].weight);
-                sxy += w * x * res[i];
-                sxx += w * x * x;
-            }
-            if sxx > 0.0 {
-                for &i in &idx {
-                    res[i] -= sxy / sxx * rows[i].x[offset];
-                }
-            }
-        }
-        res.iter()
-            .zip(rows)
-            .map(|(e, r)| r.weight * e * e)
-            .collect()
+        let rows: Vec<&WeakRow> = self.val_rows.iter().collect();
+        crate::weak::sq_with_run_offsets(&rows, fit.residuals(&self.val_rows))
     }
 
     /// `values` (one per row of this view) carried over to the rows of `other` (same runs):

@@ -208,6 +208,35 @@ fn one() -> f64 {
     1.0
 }
 
+/// Weighted squared residuals `res` of `rows` with each run's own encoder zeroing error refitted
+/// (least squares on the observation column within the run). On held-out rows that error is a
+/// nuisance of the run, not a prediction of any model (as a validate run's initial state is for
+/// E_θ): left in, a 2-count zeroing error is a torque as large as a plausible dry torque, and
+/// its scatter between runs swamps what a model changes.
+pub(crate) fn sq_with_run_offsets(rows: &[&WeakRow], mut res: Vec<f64>) -> Vec<f64> {
+    if let Some(offset) = observation_column() {
+        let runs: std::collections::BTreeSet<usize> = rows.iter().map(|r| r.run).collect();
+        for run in runs {
+            let idx: Vec<usize> = (0..rows.len()).filter(|&i| rows[i].run == run).collect();
+            let (mut sxy, mut sxx) = (0.0, 0.0);
+            for &i in &idx {
+                let (x, w) = (rows[i].x[offset], rows[i].weight);
+                sxy += w * x * res[i];
+                sxx += w * x * x;
+            }
+            if sxx > 0.0 {
+                for &i in &idx {
+                    res[i] -= sxy / sxx * rows[i].x[offset];
+                }
+            }
+        }
+    }
+    res.iter()
+        .zip(rows)
+        .map(|(e, r)| r.weight * e * e)
+        .collect()
+}
+
 /// Number of |θ̇| classes per run the residual variance is estimated in.
 const WEIGHT_CLASSES: usize = 3;
 

@@ -222,6 +222,12 @@ pub struct Dimensionless {
     /// spring, a cable): free decays of spring-loaded pendulums (issue 16). Absent = 0.
     #[serde(default)]
     pub kappa: f64,
+    /// Growth rate of the constant dry torque, dc/dt per dimensionless time (c + c_rate·t, t
+    /// from the simulation's start): a bearing whose drag grows as it runs (heating, a seal
+    /// drying out), a departure outside the catalogue for tests of an honest `unexplained`.
+    /// Absent = 0.
+    #[serde(default)]
+    pub c_rate: f64,
 }
 
 impl Default for Dimensionless {
@@ -253,6 +259,7 @@ impl Dimensionless {
             gen_c: 0.0,
             gen_w: 0.0,
             kappa: 0.0,
+            c_rate: 0.0,
         }
     }
 
@@ -277,6 +284,7 @@ impl Dimensionless {
             ("c", self.c, self.c >= 0.0),
             ("j", self.j, self.j > -1.0),
             ("kappa", self.kappa, self.kappa >= 0.0),
+            ("c_rate", self.c_rate, self.c_rate >= 0.0),
             ("s_break", self.s_break, self.s_break >= 0.0),
             (
                 "v_break",

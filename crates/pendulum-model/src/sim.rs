@@ -90,7 +90,8 @@ impl Model {
     }
 
     fn has_dry_friction(&self) -> bool {
-        self.params.m_coulomb > 0.0 || self.params.c > 0.0 || self.params.s_break > 0.0
+        let p = &self.params;
+        p.m_coulomb > 0.0 || p.c > 0.0 || p.s_break > 0.0 || p.c_rate > 0.0
     }
 
     /// Non-friction torque at rest, Q, and the static friction capacity C, at (t, θ).
@@ -110,7 +111,7 @@ impl Model {
             c.abs()
         };
         // At rest the fading dry torque holds with its full size s.
-        (q, p.m_coulomb * load + p.c + p.s_break)
+        (q, p.m_coulomb * load + p.c + p.c_rate * t + p.s_break)
     }
 
     /// The generator's mode at θ̇: ±1 on (beyond the dead band on that side), 0 off (inside it).
@@ -165,7 +166,7 @@ impl Model {
             } else {
                 (w2 + c).abs()
             };
-            let mut dry = p.m_coulomb * load + p.c;
+            let mut dry = p.m_coulomb * load + p.c + p.c_rate * t;
             // Tested, not multiplied by zero: the exp is the costliest term, and most models lack it.
             if STRIBECK && p.s_break != 0.0 {
                 let x = theta_dot / p.v_break;
@@ -220,7 +221,7 @@ impl Model {
             base: -ay * s - ax * c,
             viscous: -p.beta * theta_dot,
             quadratic: -p.alpha * theta_dot * theta_dot.abs(),
-            dry: -(p.m_coulomb * load + p.c + fading) * dir,
+            dry: -(p.m_coulomb * load + p.c + p.c_rate * t + fading) * dir,
             generator: -p.gen_c * excess * dir,
             position: -p.p * (p.k as f64 * theta + p.phi_p).sin(),
             spring: -p.kappa * theta,

@@ -86,6 +86,10 @@ pub struct Departures {
     /// encoder).
     #[serde(default)]
     pub encoder_cpr_true: Option<f64>,
+    /// A constant dry torque that grows as the rig runs, N·m per second from the capture's
+    /// start (a bearing heating up, a seal drying out): T_c(t) = rate · t, sgn θ'.
+    #[serde(default)]
+    pub dry_torque_growth_nm_per_s: Option<f64>,
 }
 
 /// Sensor and firmware imperfections (`rig.md`); defaults are the rig's typical values.
@@ -509,6 +513,10 @@ fn synthesize_run(
     let mut d = phys.to_dimensionless();
     if let Some(k) = case.truth.departures.torsion_spring_nm_per_rad {
         d.kappa = k / (phys.m_kg * phys.g_m_s2 * phys.l_m);
+    }
+    if let Some(rate) = case.truth.departures.dry_torque_growth_nm_per_s {
+        // Per dimensionless time (t̃ = ω0 t).
+        d.c_rate = rate / (phys.m_kg * phys.g_m_s2 * phys.l_m) / phys.omega0_rad_s();
     }
     let w0 = phys.omega0_rad_s();
     // Dimensionless time of the shaker start and of being at speed.
