@@ -131,12 +131,12 @@ fn regression_issue_14_mislabelled_encoder_is_unexplained() {
 /// from the capture's start, sgn θ'). A constant dry torque fits its mean, but the runs disagree
 /// on it by when their windows fall. Over four drawn campaigns nothing may be named, and every
 /// description must follow time as "a friction growing with time" with its rate (the t sgn θ̇
-/// term) within a factor of two; at least three of the four must be described. Measured: rates
-/// +0.1 %, +0.1 % and −1.8 %; the weakest draw (2.56e-4 N·m/s) is not described, its validate
-/// runs not confirming the description (held-out fall 30 % against a noise of 37 %; with
-/// position_torque screened to k = 24 only, whose columns change the weights, it was confirmed
-/// at 61 % against 30 % with its rate −30 %, 2.4 of its standard errors off: the overlapping
-/// windows' errors are correlated, so the regression's interval understates its scatter).
+/// term) within a factor of two; at least three of the four must be described. Measured: all
+/// four, rates −0.5 %, −30.0 %, −1.0 % and −3.1 %. The −30 % draw (the slowest growth,
+/// 2.56e-4 N·m/s) sits 2.4 of its standard errors off: the overlapping windows' errors are
+/// correlated, so the regression's interval understates its scatter; when its weights came from
+/// a fit with position torques up to k = 64 its validate runs did not confirm it at all (fall
+/// 30 % against a noise of 37 %), and then nothing was named and nothing said.
 #[test]
 fn regression_issue_12_growing_dry_torque_is_unexplained() {
     let mut r = rng(3);
