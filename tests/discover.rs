@@ -1099,7 +1099,9 @@ fn draw_before_the_catalogue(
                 }
                 "position_torque" => {
                     let v = r.random_range(0.015..0.04);
-                    let k = r.random_range(1..=4);
+                    // The lobe count's range grew with the screen's (k ≤ 64 since 33b22f4 and
+                    // becdebf; it was 1..=4): the survey's position torques changed there.
+                    let k = r.random_range(1..=64);
                     let phi = r.random_range(-3.0..3.0);
                     (
                         v,

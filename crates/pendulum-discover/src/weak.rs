@@ -219,14 +219,16 @@ pub(crate) fn sq_with_run_offsets(rows: &[&WeakRow], mut res: Vec<f64>) -> Vec<f
         for run in runs {
             let idx: Vec<usize> = (0..rows.len()).filter(|&i| rows[i].run == run).collect();
             let (mut sxy, mut sxx) = (0.0, 0.0);
+            // Rows without the catalogue's columns (a bare library fit) have no offset to refit.
+            let x_of = |i: usize| rows[i].x.get(offset).copied().unwrap_or(0.0);
             for &i in &idx {
-                let (x, w) = (rows[i].x[offset], rows[i].weight);
+                let (x, w) = (x_of(i), rows[i].weight);
                 sxy += w * x * res[i];
                 sxx += w * x * x;
             }
             if sxx > 0.0 {
                 for &i in &idx {
-                    res[i] -= sxy / sxx * rows[i].x[offset];
+                    res[i] -= sxy / sxx * x_of(i);
                 }
             }
         }
