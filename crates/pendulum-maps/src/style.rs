@@ -44,36 +44,12 @@ pub fn draw_index(c: SteadyClass) -> usize {
 /// slot of the simulator's coefficients, so that a map of a model with a breakaway or a
 /// generator says so in its title).
 pub fn describe_params(d: &pendulum_model::Dimensionless, skip: Option<&str>) -> String {
-    let mut parts = Vec::new();
-    let mut push = |name: &str, sym: &str, v: f64, always: bool| {
-        if skip != Some(name) && (always || v != 0.0) {
-            parts.push(format!("{sym} = {}", fmt_num(v)));
-        }
-    };
-    push("omega", "ω", d.omega, true);
-    push("R", "R", d.r, true);
-    push("lambda", "λ", d.lambda, true);
-    push("alpha", "α", d.alpha, false);
-    push("beta", "β", d.beta, true);
-    push("M", "M", d.m_coulomb, true);
-    push("c", "c", d.c, false);
-    push("p", "p", d.p, false);
-    if d.p != 0.0 {
-        push("k", "k", f64::from(d.k), true);
-        push("phi_p", "φ_p", d.phi_p, true);
-    }
-    push("s_break", "s", d.s_break, false);
-    if d.s_break != 0.0 {
-        push("v_break", "v_s", d.v_break, true);
-    }
-    push("gen_c", "c_g", d.gen_c, false);
-    if d.gen_c != 0.0 {
-        push("gen_w", "ω_d", d.gen_w, true);
-    }
-    push("kappa", "κ", d.kappa, false);
-    push("tan_delta", "tan δ", d.tan_delta, false);
-    push("j", "j", d.j, false);
-    push("omega_drift", "dω/dt", d.omega_drift, false);
+    let parts: Vec<String> = d
+        .slots()
+        .into_iter()
+        .filter(|s| skip != Some(s.name) && (s.always || s.value != 0.0))
+        .map(|s| format!("{} = {}", s.symbol, fmt_num(s.value)))
+        .collect();
     let mut out = parts.join(", ");
     if d.base_load && skip != Some("base_load") {
         out.push_str(", bearing load with the base's acceleration");

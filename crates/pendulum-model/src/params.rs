@@ -236,6 +236,18 @@ impl Default for Dimensionless {
     }
 }
 
+/// One coefficient slot of [`Dimensionless`] (see [`Dimensionless::slots`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Slot {
+    pub name: &'static str,
+    pub symbol: &'static str,
+    pub value: f64,
+    /// Printed in titles even when 0.
+    pub always: bool,
+    /// Whether the value is in its range, and the range in words (`None`: any value).
+    pub valid: Option<(bool, &'static str)>,
+}
+
 impl Dimensionless {
     /// A free pendulum with no damping and no base motion.
     pub fn conservative() -> Self {
@@ -272,39 +284,130 @@ impl Dimensionless {
         }
     }
 
-    /// Checks ranges: damping ≥ 0, λ < 1, j > −1.
-    pub fn validate(&self) -> Result<(), ModelError> {
-        let checks = [
-            ("omega", self.omega, self.omega >= 0.0),
-            ("R", self.r, self.r >= 0.0),
-            ("lambda", self.lambda, (0.0..1.0).contains(&self.lambda)),
-            ("alpha", self.alpha, self.alpha >= 0.0),
-            ("beta", self.beta, self.beta >= 0.0),
-            ("M", self.m_coulomb, self.m_coulomb >= 0.0),
-            ("c", self.c, self.c >= 0.0),
-            ("j", self.j, self.j > -1.0),
-            ("kappa", self.kappa, self.kappa >= 0.0),
-            ("c_rate", self.c_rate, self.c_rate >= 0.0),
-            ("s_break", self.s_break, self.s_break >= 0.0),
-            (
-                "v_break",
-                self.v_break,
-                self.v_break >= 0.0 && (self.s_break == 0.0 || self.v_break > 0.0),
+    /// Every coefficient slot, in one table: its name (as `--param` and the error messages say
+    /// it), the symbol titles print, its value, whether titles print it when it is 0, and its
+    /// valid range (`None`: any value). [`Dimensionless::validate`] checks the ranges and map
+    /// titles list the slots (`pendulum_maps::style::describe_params`), so a new slot is
+    /// declared here once. A slot that only means something beside another (k and φ_p of a
+    /// position torque, v_s of a breakaway, ω_d of a generator) is left out while that one is 0.
+    pub fn slots(&self) -> Vec<Slot> {
+        let slot = |name, symbol, value: f64, always, range: Option<(bool, &'static str)>| Slot {
+            name,
+            symbol,
+            value,
+            always,
+            valid: range.map(|(ok, expected)| (ok && value.is_finite(), expected)),
+        };
+        const NON_NEG: &str = "a finite value ≥ 0";
+        let mut out = vec![
+            slot(
+                "omega",
+                "ω",
+                self.omega,
+                true,
+                Some((self.omega >= 0.0, NON_NEG)),
             ),
-            ("gen_c", self.gen_c, self.gen_c >= 0.0),
-            ("gen_w", self.gen_w, self.gen_w >= 0.0),
+            slot("R", "R", self.r, true, Some((self.r >= 0.0, NON_NEG))),
+            slot(
+                "lambda",
+                "λ",
+                self.lambda,
+                true,
+                Some(((0.0..1.0).contains(&self.lambda), "0 ≤ λ < 1")),
+            ),
+            slot(
+                "alpha",
+                "α",
+                self.alpha,
+                false,
+                Some((self.alpha >= 0.0, NON_NEG)),
+            ),
+            slot(
+                "beta",
+                "β",
+                self.beta,
+                true,
+                Some((self.beta >= 0.0, NON_NEG)),
+            ),
+            slot(
+                "M",
+                "M",
+                self.m_coulomb,
+                true,
+                Some((self.m_coulomb >= 0.0, NON_NEG)),
+            ),
+            slot("c", "c", self.c, false, Some((self.c >= 0.0, NON_NEG))),
+            slot(
+                "c_rate",
+                "dc/dt",
+                self.c_rate,
+                false,
+                Some((self.c_rate >= 0.0, NON_NEG)),
+            ),
+            slot("p", "p", self.p, false, None),
         ];
-        for (name, v, ok) in checks {
-            if !(v.is_finite() && ok) {
+        if self.p != 0.0 {
+            out.push(slot("k", "k", f64::from(self.k), true, None));
+            out.push(slot("phi_p", "φ_p", self.phi_p, true, None));
+        }
+        out.push(slot(
+            "s_break",
+            "s",
+            self.s_break,
+            false,
+            Some((self.s_break >= 0.0, NON_NEG)),
+        ));
+        let v_ok = self.v_break >= 0.0 && (self.s_break == 0.0 || self.v_break > 0.0);
+        let v_break = slot(
+            "v_break",
+            "v_s",
+            self.v_break,
+            true,
+            Some((v_ok, "v > 0 when s > 0")),
+        );
+        if self.s_break != 0.0 || !v_break.valid.is_none_or(|v| v.0) {
+            out.push(v_break);
+        }
+        out.push(slot(
+            "gen_c",
+            "c_g",
+            self.gen_c,
+            false,
+            Some((self.gen_c >= 0.0, NON_NEG)),
+        ));
+        let gen_w = slot(
+            "gen_w",
+            "ω_d",
+            self.gen_w,
+            true,
+            Some((self.gen_w >= 0.0, NON_NEG)),
+        );
+        if self.gen_c != 0.0 || !gen_w.valid.is_none_or(|v| v.0) {
+            out.push(gen_w);
+        }
+        out.extend([
+            slot(
+                "kappa",
+                "κ",
+                self.kappa,
+                false,
+                Some((self.kappa >= 0.0, NON_NEG)),
+            ),
+            slot("tan_delta", "tan δ", self.tan_delta, false, None),
+            slot("j", "j", self.j, false, Some((self.j > -1.0, "j > −1"))),
+            slot("omega_drift", "dω/dt", self.omega_drift, false, None),
+        ]);
+        out
+    }
+
+    /// Checks ranges: damping ≥ 0, λ < 1, j > −1 (the ranges of [`Dimensionless::slots`]).
+    pub fn validate(&self) -> Result<(), ModelError> {
+        for slot in self.slots() {
+            if let Some((false, expected)) = slot.valid {
                 return Err(ModelError::OutOfRange {
-                    name: name.into(),
-                    value: v,
-                    expected: match name {
-                        "lambda" => "0 ≤ λ < 1".into(),
-                        "j" => "j > −1".into(),
-                        "v_break" => "v > 0 when s > 0".into(),
-                        _ => "a finite value ≥ 0".into(),
-                    },
+                    name: slot.name.into(),
+                    value: slot.value,
+                    expected: expected.into(),
                 });
             }
         }
@@ -439,5 +542,46 @@ mod tests {
             ..Dimensionless::default()
         };
         assert!(d.validate().is_err());
+    }
+
+    /// The slot table's ranges are what `validate` enforces, each error naming its slot and
+    /// range; a slot that means something only beside another is listed only then.
+    #[test]
+    fn slots_carry_the_ranges_validate_enforces() {
+        let err = |d: Dimensionless| d.validate().unwrap_err().to_string();
+        let d0 = Dimensionless::default();
+        assert!(d0.validate().is_ok());
+        let e = err(Dimensionless { lambda: 1.0, ..d0 });
+        assert!(e.contains("lambda") && e.contains("0 ≤ λ < 1"), "{e}");
+        let e = err(Dimensionless {
+            c_rate: -1e-6,
+            ..d0
+        });
+        assert!(e.contains("c_rate"), "{e}");
+        let e = err(Dimensionless {
+            s_break: 0.01,
+            v_break: 0.0,
+            ..d0
+        });
+        assert!(
+            e.contains("v_break") && e.contains("v > 0 when s > 0"),
+            "{e}"
+        );
+        let e = err(Dimensionless {
+            beta: f64::NAN,
+            ..d0
+        });
+        assert!(e.contains("beta"), "{e}");
+        let names = |d: &Dimensionless| d.slots().iter().map(|s| s.name).collect::<Vec<_>>();
+        assert!(!names(&d0).contains(&"k") && !names(&d0).contains(&"v_break"));
+        let with = Dimensionless {
+            p: 0.01,
+            s_break: 0.01,
+            v_break: 0.1,
+            ..d0
+        };
+        for n in ["k", "phi_p", "v_break"] {
+            assert!(names(&with).contains(&n), "{n}");
+        }
     }
 }
