@@ -17,11 +17,24 @@ fn campaign(seed: u64, a: f64, b: f64, mu: f64, effects: &str) -> String {
 
 fn discover(seed: u64, base: Base, a: f64, b: f64, mu: f64, effects: &str) -> DiscoverSummary {
     let dir = tempfile::tempdir().unwrap();
-    let camp = dir.path().join("campaign");
+    discover_in(dir.path(), seed, base, a, b, mu, effects)
+}
+
+/// [`discover`] into `dir` (campaign and outputs stay there).
+fn discover_in(
+    dir: &Path,
+    seed: u64,
+    base: Base,
+    a: f64,
+    b: f64,
+    mu: f64,
+    effects: &str,
+) -> DiscoverSummary {
+    let camp = dir.join("campaign");
     make_campaign(&camp, &campaign(seed, a, b, mu, effects));
     let s = run(&DiscoverJob {
         input: camp,
-        out: dir.path().join("out"),
+        out: dir.join("out"),
         base,
         pipeline: None,
         generations: Some(300),
@@ -204,7 +217,9 @@ fn regression_issue_12_finds_motor_cogging() {
     let k: u32 = r.random_range(6..=64);
     let tp = r.random_range(0.015..0.04);
     let phi = r.random_range(-3.0..3.0);
-    let s = discover(
+    let dir = tempfile::tempdir().unwrap();
+    let s = discover_in(
+        dir.path(),
         12_024,
         Base::Reference,
         0.0,
@@ -221,6 +236,17 @@ fn regression_issue_12_finds_motor_cogging() {
         .find(|r| r.effect == "position_torque")
         .unwrap();
     assert!(row.note.starts_with(&format!("k = {k};")), "{}", row.note);
+    // params.parquet carries the lobe count, which no fit varies, so a reader (validate, replay,
+    // the maps) rebuilds the same model: it was read back as k = 1.
+    let back = pendulum_jobs::outputs::read_params(
+        &dir.path().join("out/params.parquet"),
+        Some("reference+position_torque"),
+    )
+    .unwrap();
+    assert_eq!(
+        back.spec.fixed.value("position_torque.k"),
+        Some(f64::from(k))
+    );
 }
 
 #[test]

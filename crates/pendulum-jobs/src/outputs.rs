@@ -19,6 +19,19 @@ use pendulum_process::pipeline::Context;
 use pendulum_process::{RigParams, Role};
 use pendulum_report::{Column, ColumnData, TableOptions};
 
+/// The catalogue's parameters no fit varies (`position_torque.k`: the screen's lobe count), with
+/// their units: `params.parquet` carries them beside the refitted ones, from the model's held
+/// values, so that a reader (`validate`, `replay`, the maps) rebuilds the same model. Without
+/// the column a position torque of k = 50 was read back as k = 1.
+fn held_params() -> impl Iterator<Item = (&'static str, &'static str)> {
+    pendulum_model::CATALOGUE.iter().flat_map(|e| {
+        e.params()
+            .iter()
+            .filter(|p| p.fit_range.is_none())
+            .map(|p| (p.key, p.unit))
+    })
+}
+
 use crate::identify::{residuals_of, segment_residuals_of};
 use crate::inputs::Inputs;
 use crate::JobError;
@@ -392,6 +405,14 @@ pub fn params_columns(ctx: &Context, fits: &[FitOutcome]) -> Vec<Column> {
             };
             push(p.name(), p.unit(), v, row);
         }
+        for (key, unit) in held_params() {
+            push(
+                key,
+                unit,
+                fit.spec.fixed.value(key).unwrap_or(f64::NAN),
+                row,
+            );
+        }
         fit_stats(&mut push, fit, row);
     }
     let n_rows = model.len();
@@ -462,6 +483,9 @@ fn free_decay_row(
     push("omega_hz", "Hz", nan, row);
     for p in FitParam::all_effects() {
         push(p.name(), p.unit(), val(p).unwrap_or(nan), row);
+    }
+    for (key, unit) in held_params() {
+        push(key, unit, fit.spec.fixed.value(key).unwrap_or(nan), row);
     }
     push("omega0_rad_s", "rad/s", w0, row);
     push("c", "rad", val(FitParam::DryC).unwrap_or(nan), row);
@@ -539,6 +563,11 @@ pub fn read_params(path: &Path, model: Option<&str>) -> Result<FitOutcome, JobEr
             for p in FitParam::all_effects() {
                 if given(p) {
                     spec.params.push(p);
+                }
+            }
+            for (key, _) in held_params() {
+                if let Some(v) = get(key).filter(|v| v.is_finite()) {
+                    spec.fixed.set_value(key, v);
                 }
             }
             // A free-decay row (it has ω0): the same model in identifiable terms.
