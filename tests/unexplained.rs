@@ -185,3 +185,36 @@ fn regression_issue_12_growing_dry_torque_is_unexplained() {
     }
     assert!(described >= 3, "described {described} of 4");
 }
+
+/// A departure outside its physical range is refused when the case is read, naming its key: a
+/// negative friction growth (or spring) would feed energy in, which no rig does.
+#[test]
+fn departures_outside_their_range_are_refused_by_key() {
+    for (departure, key) in [
+        (
+            "dry_torque_growth_nm_per_s = -3e-4",
+            "dry_torque_growth_nm_per_s",
+        ),
+        (
+            "torsion_spring_nm_per_rad = -0.1",
+            "torsion_spring_nm_per_rad",
+        ),
+        ("encoder_cpr_true = 0.0", "encoder_cpr_true"),
+    ] {
+        let toml = pendulum_jobs::demo::discovery_campaign(
+            "departure",
+            1,
+            0.0,
+            0.5,
+            0.15,
+            &format!("\n[truth.departures]\n{departure}"),
+        );
+        let err = pendulum_rig::twin::TwinCase::from_toml(&toml, std::path::Path::new("case.toml"))
+            .expect_err(departure)
+            .to_string();
+        assert!(
+            err.contains(&format!("truth.departures.{key}")),
+            "{departure}: {err}"
+        );
+    }
+}

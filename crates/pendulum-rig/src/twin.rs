@@ -92,6 +92,31 @@ pub struct Departures {
     pub dry_torque_growth_nm_per_s: Option<f64>,
 }
 
+impl Departures {
+    /// The first departure outside its physical range, as (key, what was expected): a spring or
+    /// a friction growth below 0 would feed energy in, and an encoder needs counts per turn.
+    pub fn invalid(&self) -> Option<(&'static str, &'static str)> {
+        let bad =
+            |v: Option<f64>, ok: fn(f64) -> bool| v.is_some_and(|v| !(v.is_finite() && ok(v)));
+        if bad(self.torsion_spring_nm_per_rad, |v| v >= 0.0) {
+            return Some((
+                "torsion_spring_nm_per_rad",
+                "a finite stiffness ≥ 0 N·m/rad",
+            ));
+        }
+        if bad(self.encoder_cpr_true, |v| v >= 1.0) {
+            return Some(("encoder_cpr_true", "a finite count per revolution ≥ 1"));
+        }
+        if bad(self.dry_torque_growth_nm_per_s, |v| v >= 0.0) {
+            return Some((
+                "dry_torque_growth_nm_per_s",
+                "a finite growth ≥ 0 N·m/s (a dry torque that shrinks below 0 would feed energy in)",
+            ));
+        }
+        None
+    }
+}
+
 /// Sensor and firmware imperfections (`rig.md`); defaults are the rig's typical values.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -300,6 +325,14 @@ impl TwinCase {
                 key: "rig/truth".into(),
                 expected: e.to_string(),
             })?;
+        if let Some((key, expected)) = case.truth.departures.invalid() {
+            return Err(RigError::CampaignKey {
+                path: path.to_path_buf(),
+                run: None,
+                key: format!("truth.departures.{key}"),
+                expected: expected.into(),
+            });
+        }
         for run in &case.runs {
             let duration_s = run.free_s + run.forced_s;
             if !(duration_s <= MAX_RUN_S) {
