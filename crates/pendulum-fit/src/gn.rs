@@ -8,7 +8,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::FitError;
 use crate::least_squares::{
-    jtj, prepare, project, sum_of_squares, Evaluator, LeastSquaresProblem, LsResult, LsStop,
+    jtj, neg_jt_r, prepare, project, sum_of_squares, Evaluator, LeastSquaresProblem, LsResult,
+    LsStop,
 };
 
 /// Settings of [`GaussNewton`]. Deserialises from partial tables (missing fields take the
@@ -146,10 +147,7 @@ impl GaussNewton {
         while iterations < cfg.max_iterations {
             iterations += 1;
             let a = jtj(&jac);
-            let g: Vec<f64> = jac
-                .iter()
-                .map(|c| -c.iter().zip(&r).map(|(u, w)| u * w).sum::<f64>())
-                .collect();
+            let g = neg_jt_r(&jac, &r);
             let delta = solve_spd(&a, &g, p).map_err(|_| FitError::Singular {
                 x: x.clone(),
                 iteration: iterations,

@@ -115,6 +115,13 @@ pub(crate) fn jtj(jac: &[Vec<f64>]) -> Vec<f64> {
     a
 }
 
+/// −Jᵀr, the right-hand side of the normal equations (`jac` by columns), for both solvers.
+pub(crate) fn neg_jt_r(jac: &[Vec<f64>], r: &[f64]) -> Vec<f64> {
+    jac.iter()
+        .map(|c| -c.iter().zip(r).map(|(u, w)| u * w).sum::<f64>())
+        .collect()
+}
+
 /// Why a least-squares solver stopped.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 pub enum LsStop {

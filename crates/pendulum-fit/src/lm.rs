@@ -14,7 +14,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::FitError;
 use crate::least_squares::{
-    jtj, prepare, project, sum_of_squares, Evaluator, LeastSquaresProblem, LsResult, LsStop,
+    jtj, neg_jt_r, prepare, project, sum_of_squares, Evaluator, LeastSquaresProblem, LsResult,
+    LsStop,
 };
 
 /// Settings of [`LevenbergMarquardt`]. Deserialises from partial tables (missing fields take the
@@ -153,10 +154,7 @@ impl LevenbergMarquardt {
             iterations += 1;
             let a = jtj(&jac);
             // −Jᵀr: the right-hand side of the normal equations.
-            let g: Vec<f64> = jac
-                .iter()
-                .map(|c| -c.iter().zip(&r).map(|(u, w)| u * w).sum::<f64>())
-                .collect();
+            let g = neg_jt_r(&jac, &r);
             let mut accepted = None;
             for _ in 0..cfg.max_tries {
                 let Some(delta) = damped_step(&a, &g, lambda, &x, &bounds) else {
