@@ -90,6 +90,17 @@ pub struct Departures {
     /// start (a bearing heating up, a seal drying out): T_c(t) = rate · t, sgn θ'.
     #[serde(default)]
     pub dry_torque_growth_nm_per_s: Option<f64>,
+    /// Play between the shaft and the encoder (a loose coupling), rad: the encoder's disc stays
+    /// put while the shaft turns inside the play and is dragged along at its edge, so the
+    /// measured angle lags the shaft by half the play in the direction of motion and stands
+    /// still for a moment at every turn-around (a dead band in the measured angle).
+    #[serde(default)]
+    pub encoder_backlash_rad: Option<f64>,
+    /// Bearing friction that differs from run to run (a bearing re-seated, warmed or re-greased
+    /// between runs): each run's μ is the truth's times 1 + u, u drawn uniformly within
+    /// ± this fraction from the run's own seed.
+    #[serde(default)]
+    pub mu_run_spread: Option<f64>,
 }
 
 impl Departures {
@@ -106,6 +117,18 @@ impl Departures {
         }
         if bad(self.encoder_cpr_true, |v| v >= 1.0) {
             return Some(("encoder_cpr_true", "a finite count per revolution ≥ 1"));
+        }
+        if bad(self.encoder_backlash_rad, |v| (0.0..1.0).contains(&v)) {
+            return Some((
+                "encoder_backlash_rad",
+                "a finite play in [0, 1) rad between shaft and encoder",
+            ));
+        }
+        if bad(self.mu_run_spread, |v| (0.0..1.0).contains(&v)) {
+            return Some((
+                "mu_run_spread",
+                "a finite fraction in [0, 1) (a bearing friction below 0 would feed energy in)",
+            ));
         }
         if bad(self.dry_torque_growth_nm_per_s, |v| v >= 0.0) {
             return Some((
@@ -521,6 +544,20 @@ impl Drop for TempFile {
     }
 }
 
+/// The angle an encoder coupled with `play` rad of backlash reads, in place: its disc starts
+/// centred on the shaft and moves only when the shaft reaches an edge of the play.
+fn backlash(theta: &mut [f64], play: f64) {
+    let half = 0.5 * play;
+    let Some(&first) = theta.first() else {
+        return;
+    };
+    let mut disc = first;
+    for th in theta.iter_mut() {
+        disc = disc.clamp(*th - half, *th + half);
+        *th = disc;
+    }
+}
+
 fn synthesize_run(
     case: &TwinCase,
     run: &TwinRun,
@@ -546,6 +583,9 @@ fn synthesize_run(
     let mut d = phys.to_dimensionless();
     if let Some(k) = case.truth.departures.torsion_spring_nm_per_rad {
         d.kappa = k / (phys.m_kg * phys.g_m_s2 * phys.l_m);
+    }
+    if let Some(spread) = case.truth.departures.mu_run_spread {
+        d.m_coulomb *= 1.0 + rng.random_range(-spread..=spread);
     }
     if let Some(rate) = case.truth.departures.dry_torque_growth_nm_per_s {
         // Per dimensionless time (t̃ = ω0 t).
@@ -750,6 +790,9 @@ fn synthesize_run(
         0
     };
     let cpr_true = case.truth.departures.encoder_cpr_true.unwrap_or(4096.0);
+    if let Some(play) = case.truth.departures.encoder_backlash_rad {
+        backlash(&mut theta, play);
+    }
     let counts: Vec<i64> = theta
         .iter()
         .map(|&th| (cpr_true * sensors.theta_measured(th) / two_pi).floor() as i64 + zero_err)
