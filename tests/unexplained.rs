@@ -243,6 +243,11 @@ fn friction_that_differs_from_run_to_run_names_nothing() {
             "case {case}: named {:?} for a bearing friction spread ± {spread:.2} over runs",
             s.discovery.accepted()
         );
+        let words = s.discovery.unexplained.as_deref().unwrap_or_default();
+        assert!(
+            words.contains("a torque that follows the run"),
+            "case {case}: {words}"
+        );
     }
 }
 

@@ -1832,6 +1832,24 @@ pub fn discover(
             format!("the remaining equation error varies with {name} (F = {f:.1}, p = {p:.1e} over 12 bins)")
         }),
     };
+    // Whether the runs disagree on the model's own terms (the variable "the run").
+    let spread = {
+        let pooled: Vec<f64> = current_cols
+            .iter()
+            .map(|&c| final_ols.coef_of(c).map_or(0.0, |v| v.0))
+            .collect();
+        crate::sparse::run_spread(&view.weak, &final_res, &current_cols, &pooled, &id_mask)
+    };
+    let structure = match (
+        structure,
+        spread
+            .as_ref()
+            .filter(|sp| sp.confirmed(cfg.eq_gain_min))
+            .map(|sp| sp.words(&|r| view.weak_runs[r].0.clone())),
+    ) {
+        (Some(a), Some(b)) => Some(format!("{a}; {b}")),
+        (a, b) => a.or(b),
+    };
     let unexplained = match (refused, structure) {
         (Some(r), Some(s)) => Some(format!("{r}; {s}")),
         (Some(r), None) => Some(r),

@@ -436,6 +436,112 @@ pub fn describe(
     })
 }
 
+/// Length of the alternating blocks a run's rows are split into to judge run-to-run terms within
+/// each run, s: long beside the weak form's ±0.16 s windows (so that a test row shares almost no
+/// samples with a fitting row), short beside a run (a 30 s run gives seven blocks of each kind).
+pub const RUN_BLOCK_S: f64 = 2.0;
+
+/// The model's damping scaled run by run (effects.md's last variable, "the run": a bearing
+/// re-seated, warmed or re-greased between runs): what one campaign-wide model cannot say,
+/// because the runs disagree on how much its losses take.
+#[derive(Debug, Clone)]
+pub struct RunSpread {
+    /// Fall of the identify runs' squared equation error on their odd blocks when each run's
+    /// scale is fitted on its even blocks, against the campaign-wide model; its noise.
+    pub heldout_gain: f64,
+    pub heldout_noise: f64,
+    /// Per run: (run, the factor its damping takes beside the campaign's).
+    pub factors: Vec<(usize, f64)>,
+}
+
+impl RunSpread {
+    /// Whether the runs' own scales predict their held-out blocks beyond `gain_min` and the noise.
+    pub fn confirmed(&self, gain_min: f64) -> bool {
+        self.heldout_gain > gain_min.max(self.heldout_noise)
+    }
+
+    /// Words a mechanic can act on.
+    pub fn words(&self, run_names: &dyn Fn(usize) -> String) -> String {
+        let per: Vec<String> = self
+            .factors
+            .iter()
+            .map(|(r, f)| format!("{} ×{f:.2}", run_names(*r)))
+            .collect();
+        format!(
+            "a torque that follows the run: the runs disagree on the size of the model's damping, by run {} (each run's own factor, fitted on alternate {RUN_BLOCK_S} s blocks, takes {:.1} % off the other blocks' equation error, noise {:.1} %)",
+            per.join(", "),
+            100.0 * self.heldout_gain,
+            100.0 * self.heldout_noise,
+        )
+    }
+}
+
+/// Whether the runs disagree on the size of the model's damping: the torque of the model's loss
+/// columns among `cols` ([`crate::weak::is_loss`]) at the campaign-wide values `pooled`
+/// (already taken off `residual`) is scaled by one factor per identify run, fitted on its
+/// even [`RUN_BLOCK_S`] blocks and judged on its odd ones, each run's encoder zeroing refitted on
+/// both sides (a zeroing error of a few counts is the rig's own run-to-run difference, not a
+/// departure). One factor per run because a run keeps only a few dozen weak-form rows where it
+/// moves. `None` with fewer than two runs to compare.
+pub fn run_spread(
+    rows: &[WeakRow],
+    residual: &[f64],
+    cols: &[usize],
+    pooled: &[f64],
+    is_identify: &[bool],
+) -> Option<RunSpread> {
+    let torque = |r: &WeakRow| -> f64 {
+        cols.iter()
+            .zip(pooled)
+            .filter(|(c, _)| crate::weak::is_loss(**c))
+            .map(|(&c, v)| r.x[c] * v)
+            .sum()
+    };
+    let fitting = |r: &WeakRow| (r.tau_s / RUN_BLOCK_S).floor().rem_euclid(2.0) == 0.0;
+    let mut runs: Vec<usize> = (0..rows.len())
+        .filter(|&i| is_identify[i])
+        .map(|i| rows[i].run)
+        .collect();
+    runs.sort_unstable();
+    runs.dedup();
+    let mut test: Vec<usize> = Vec::new();
+    let mut after: Vec<f64> = Vec::new();
+    let mut factors: Vec<(usize, f64)> = Vec::new();
+    for &run in &runs {
+        let idx: Vec<usize> = (0..rows.len())
+            .filter(|&i| is_identify[i] && rows[i].run == run && residual[i].is_finite())
+            .collect();
+        let (fit, held): (Vec<usize>, Vec<usize>) = idx.iter().partition(|&&i| fitting(&rows[i]));
+        if fit.len() < 5 || held.len() < 5 {
+            continue;
+        }
+        let (sxy, sxx) = fit.iter().fold((0.0, 0.0), |(sxy, sxx), &i| {
+            let (z, w) = (torque(&rows[i]), rows[i].weight);
+            (sxy + w * z * residual[i], sxx + w * z * z)
+        });
+        if !(sxx > 0.0) {
+            continue;
+        }
+        let delta = sxy / sxx;
+        after.extend(held.iter().map(|&i| residual[i] - delta * torque(&rows[i])));
+        test.extend(held);
+        factors.push((run, 1.0 + delta));
+    }
+    if factors.len() < 2 {
+        return None;
+    }
+    let held_rows: Vec<&WeakRow> = test.iter().map(|&i| &rows[i]).collect();
+    let before =
+        crate::weak::sq_with_run_offsets(&held_rows, test.iter().map(|&i| residual[i]).collect());
+    let after = crate::weak::sq_with_run_offsets(&held_rows, after);
+    let (heldout_gain, heldout_noise) = crate::discover::paired_gain(&before, &after);
+    Some(RunSpread {
+        heldout_gain,
+        heldout_noise,
+        factors,
+    })
+}
+
 /// The variables a catalogue effect's torque follows, when its regressor is a function of them
 /// alone (so that the library can describe the same departure in that variable with a freer
 /// shape); empty for effects that couple to the forcing or the sensors (their regressors carry

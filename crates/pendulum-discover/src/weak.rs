@@ -57,6 +57,16 @@ pub fn group_columns(effect: &str, group: u32) -> Vec<usize> {
         .collect()
 }
 
+/// Whether column `c` (catalogue or shaped) is a loss: a torque of the equation of motion that
+/// can only take energy out (damping, dry friction, a generator).
+pub fn is_loss(c: usize) -> bool {
+    let effect = match columns().get(c) {
+        Some(col) => Some(col.effect),
+        None => shaped(c).and_then(|s| pendulum_model::effects::by_name(s.effect)),
+    };
+    effect.is_some_and(|e| e.kind() == Kind::Dynamics && e.positive())
+}
+
 /// The column of the inertia beside the bob's (the catalogue's mass effect): the screen divides
 /// the dynamics columns by 1 + J/(m l²) of each run.
 pub fn mass_column() -> Option<usize> {
