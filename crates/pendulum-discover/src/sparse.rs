@@ -7,7 +7,9 @@
 //! The description is then judged like a catalogue effect, on the validate runs' rows it never
 //! saw (a paired fall of their squared equation error that must beat its own noise), and
 //! reported in words a mechanic can act on: the variable it follows, its shape, its size as a
-//! torque, and the runs it shows on.
+//! torque, and the runs it shows on. The last variable, the run, is judged within the identify
+//! runs ([`run_spread`]): a run's own scale of the model's damping, fitted on alternate blocks of
+//! that run and tested on the others.
 //!
 //! Each library column is the window integral ∫K·f over the row's window (like the catalogue's
 //! regressors in [`crate::weak`]), multiplied by the run's 1/(m g l), so that every coefficient is
@@ -758,5 +760,41 @@ mod tests {
         assert!((k + 0.004).abs() < 3.0 * se.max(1e-6), "k = {k} ± {se}");
         assert!(d.heldout_gain > d.heldout_noise, "{d:?}");
         assert!(describe(&rows, &noise, &lib, &nuis, &is_id, &centre).is_none());
+    }
+
+    /// Runs whose viscous damping differs (×0.8, ×1.0, ×1.25 of the campaign's) leave residuals
+    /// that each run's own scale predicts on its held-out blocks, and the factors come back;
+    /// runs that share it, with the same noise, are not split.
+    #[test]
+    fn runs_that_disagree_on_the_damping_are_told_apart_from_noise() {
+        let lin = crate::weak::column_of("viscous_linear").expect("a viscous column");
+        let width = crate::weak::columns().len();
+        let b = 0.5;
+        let truth = [0.8, 1.0, 1.25];
+        let (mut rows, mut spread, mut shared) = (vec![], vec![], vec![]);
+        for i in 0..900 {
+            let run = i % 3;
+            let mut r = row(run, 1.0);
+            r.tau_s = 0.1 * (i / 3) as f64;
+            r.x = vec![0.0; width];
+            r.x[lin] = 2.0 * (0.37 * i as f64).sin() + 0.5;
+            let e = 0.01 * (((i as f64 * 12.9898).sin() * 43_758.545).fract() - 0.5);
+            // The residual after the campaign-wide fit at b: what each run's own b leaves.
+            let own = b * truth[run];
+            spread.push((own - b) * r.x[lin] + e);
+            shared.push(e);
+            rows.push(r);
+        }
+        let is_id = vec![true; rows.len()];
+        let s = run_spread(&rows, &spread, &[lin], &[b], &is_id).expect("a spread");
+        assert!(s.confirmed(0.05), "{s:?}");
+        for (run, f) in &s.factors {
+            assert!((f - truth[*run]).abs() < 0.01, "run {run}: ×{f}");
+        }
+        let s0 = run_spread(&rows, &shared, &[lin], &[b], &is_id).expect("a spread");
+        assert!(!s0.confirmed(0.05), "{s0:?}");
+        // Nothing to scale: no loss among the columns.
+        let off = crate::weak::observation_column().expect("an offset column");
+        assert!(run_spread(&rows, &spread, &[off], &[1e-3], &is_id).is_none());
     }
 }
