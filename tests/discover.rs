@@ -504,6 +504,17 @@ fn issue_15_finds_the_generator_when_hidden() {
 /// lines, base, a, b, μ), from the effect's catalogue entry (`Effect::survey`): the base model
 /// that lacks it, then its parameters drawn in the entry's order (the first is the truth).
 fn draw(effect: &str, r: &mut rand_chacha::ChaCha8Rng) -> (f64, String, Base, f64, f64, f64) {
+    draw_scaled(effect, r, 1.0)
+}
+
+/// [`draw`] with the effect's size (its first drawn parameter) times `size_scale`: the survey's
+/// `SURVEY_SIZE_SCALE` asks how discover fares on effects smaller than the catalogue's survey
+/// draws them (a held-out set may draw other sizes).
+fn draw_scaled(
+    effect: &str,
+    r: &mut rand_chacha::ChaCha8Rng,
+    size_scale: f64,
+) -> (f64, String, Base, f64, f64, f64) {
     use pendulum_model::effects::{by_name, Draw};
     let e = by_name(effect).unwrap_or_else(|| panic!("no catalogue effect {effect}"));
     let survey = e.survey();
@@ -537,6 +548,11 @@ fn draw(effect: &str, r: &mut rand_chacha::ChaCha8Rng) -> (f64, String, Base, f6
                 v * sign(r)
             }
             Draw::Int(lo, hi) => f64::from(r.random_range(lo..=hi)),
+        };
+        let v = if assignments.is_empty() {
+            v * size_scale
+        } else {
+            v
         };
         assignments.push(format!("{key}={v}"));
     }
@@ -590,6 +606,11 @@ fn survey_issue_5_every_effect() {
         .collect();
     effects.extend(newer);
     let (mut hits, mut total, mut within) = (0, 0, 0);
+    // `SURVEY_SIZE_SCALE=0.4` draws every size at 0.4 times the catalogue's survey range.
+    let size_scale: f64 = std::env::var("SURVEY_SIZE_SCALE")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(1.0);
     // `SURVEY_ONE=effect:k` re-runs one campaign of the survey (`SURVEY_KEEP=DIR` keeps it).
     let one = std::env::var("SURVEY_ONE").ok();
     for (e_idx, effect) in effects.iter().enumerate() {
@@ -601,7 +622,7 @@ fn survey_issue_5_every_effect() {
                 continue;
             }
             let mut r = rng(1000 + 100 * e_idx as u64 + k);
-            let (truth, spec, base, a, b, mu) = draw(effect, &mut r);
+            let (truth, spec, base, a, b, mu) = draw_scaled(effect, &mut r, size_scale);
             let s = discover(5000 + 100 * e_idx as u64 + k, base, a, b, mu, &spec);
             let accepted = s.discovery.accepted();
             let row = s.discovery.rows.iter().find(|r| r.effect == *effect);

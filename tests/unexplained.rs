@@ -251,6 +251,39 @@ fn friction_that_differs_from_run_to_run_names_nothing() {
     }
 }
 
+/// A cable that hangs slack near the hanging position and pulls as a spring beyond ± its slack
+/// (a dead band in the unwrapped θ; k 0.1–0.3 N·m/rad, slack 0.3–1 rad): nothing may be named
+/// on two drawn campaigns, and where `unexplained` speaks it must say the torque follows the
+/// unwrapped θ. Measured (CLI, two kept designs of the growth test, k = 0.2, slack 0.6): both
+/// `unexplained` following θ (unwrapped), "linear in the unwrapped θ (a spring), cubic", the
+/// linear term 0.17 N·m/rad; one refused `extra_inertia` as impossible (−2.1e-3 kg·m²).
+#[test]
+fn slack_cable_is_unexplained_and_follows_the_angle() {
+    let mut r = rng(6);
+    for case in 0..2 {
+        let k = r.random_range(0.1..0.3);
+        let slack = r.random_range(0.3..1.0);
+        let (b, mu) = (r.random_range(0.3..0.7), r.random_range(0.08..0.2));
+        let s = discover_with(
+            7600 + case,
+            b,
+            mu,
+            &format!("torsion_spring_nm_per_rad = {k}\ncable_slack_rad = {slack}"),
+        );
+        let d = &s.discovery;
+        assert!(
+            d.accepted().is_empty(),
+            "case {case}: named {:?} for a {k:.3} N·m/rad cable slack by ± {slack:.2} rad",
+            d.accepted()
+        );
+        let words = d
+            .unexplained
+            .as_deref()
+            .unwrap_or_else(|| panic!("case {case}: no `unexplained`"));
+        assert!(words.contains("θ (unwrapped)"), "case {case}: {words}");
+    }
+}
+
 /// A departure outside its physical range is refused when the case is read, naming its key: a
 /// negative friction growth (or spring) would feed energy in, which no rig does.
 #[test]
@@ -267,6 +300,11 @@ fn departures_outside_their_range_are_refused_by_key() {
         ("encoder_cpr_true = 0.0", "encoder_cpr_true"),
         ("encoder_backlash_rad = -0.01", "encoder_backlash_rad"),
         ("mu_run_spread = 1.5", "mu_run_spread"),
+        (
+            "torsion_spring_nm_per_rad = 0.1\ncable_slack_rad = -0.2",
+            "cable_slack_rad",
+        ),
+        ("cable_slack_rad = 0.5", "cable_slack_rad"),
     ] {
         let toml = pendulum_jobs::demo::discovery_campaign(
             "departure",

@@ -222,12 +222,26 @@ pub struct Dimensionless {
     /// spring, a cable): free decays of spring-loaded pendulums (issue 16). Absent = 0.
     #[serde(default)]
     pub kappa: f64,
+    /// Half-width of the spring's slack, rad: a cable that hangs slack while |θ| ≤ this and
+    /// pulls, as −κ(θ ∓ slack), beyond it (a departure outside the catalogue for tests of an
+    /// honest `unexplained`). Absent = 0: the spring acts everywhere.
+    #[serde(default)]
+    pub kappa_slack: f64,
     /// Growth rate of the constant dry torque, dc/dt per dimensionless time (c + c_rate·t, t
     /// from the simulation's start): a bearing whose drag grows as it runs (heating, a seal
     /// drying out), a departure outside the catalogue for tests of an honest `unexplained`.
     /// Absent = 0.
     #[serde(default)]
     pub c_rate: f64,
+}
+
+impl Dimensionless {
+    /// The spring's stretch at θ: θ itself, or beyond a slack of ±`kappa_slack` what lies past
+    /// it (torque −κ·stretch, energy κ·stretch²/2).
+    #[inline]
+    pub fn spring_stretch(&self, theta: f64) -> f64 {
+        theta - theta.clamp(-self.kappa_slack, self.kappa_slack)
+    }
 }
 
 impl Default for Dimensionless {
@@ -271,6 +285,7 @@ impl Dimensionless {
             gen_c: 0.0,
             gen_w: 0.0,
             kappa: 0.0,
+            kappa_slack: 0.0,
             c_rate: 0.0,
         }
     }
@@ -392,6 +407,13 @@ impl Dimensionless {
                 self.kappa,
                 false,
                 Some((self.kappa >= 0.0, NON_NEG)),
+            ),
+            slot(
+                "kappa_slack",
+                "θ_slack",
+                self.kappa_slack,
+                false,
+                Some((self.kappa_slack >= 0.0, NON_NEG)),
             ),
             slot("tan_delta", "tan δ", self.tan_delta, false, None),
             slot("j", "j", self.j, false, Some((self.j > -1.0, "j > −1"))),

@@ -102,12 +102,13 @@ impl MeanPowers {
 }
 
 /// Mechanical energy per m g l: kinetic (with extra inertia), gravity, the position torque's
-/// potential −(p/k) cos(kθ + φ_p) and the spring's κθ²/2. Its rate is the power of the
+/// potential −(p/k) cos(kθ + φ_p) and the spring's κ·stretch²/2. Its rate is the power of the
 /// non-conservative torques.
 pub fn mechanical_energy(model: &Model, theta: f64, theta_dot: f64) -> f64 {
     let p = &model.params;
     let k = p.k as f64;
-    0.5 * (1.0 + p.j) * theta_dot * theta_dot - theta.cos() + 0.5 * p.kappa * theta * theta
+    0.5 * (1.0 + p.j) * theta_dot * theta_dot - theta.cos()
+        + 0.5 * p.kappa * p.spring_stretch(theta).powi(2)
         - p.p / k * (k * theta + p.phi_p).cos()
 }
 

@@ -104,7 +104,7 @@ impl Model {
         if p.p != 0.0 {
             q -= p.p * (p.k as f64 * theta + p.phi_p).sin();
         }
-        q -= p.kappa * theta;
+        q -= p.kappa * p.spring_stretch(theta);
         let load = if p.base_load {
             ((1.0 + ay) * c - ax * s).abs()
         } else {
@@ -181,7 +181,9 @@ impl Model {
         if p.p != 0.0 {
             q -= p.p * (p.k as f64 * theta + p.phi_p).sin();
         }
-        q -= p.kappa * theta;
+        if p.kappa != 0.0 {
+            q -= p.kappa * p.spring_stretch(theta);
+        }
         if p.j != 0.0 {
             q / (1.0 + p.j)
         } else {
@@ -224,14 +226,15 @@ impl Model {
             dry: -(p.m_coulomb * load + p.c + p.c_rate * t + fading) * dir,
             generator: -p.gen_c * excess * dir,
             position: -p.p * (p.k as f64 * theta + p.phi_p).sin(),
-            spring: -p.kappa * theta,
+            spring: -p.kappa * p.spring_stretch(theta),
         }
     }
 
-    /// Mechanical energy per m g l of the unforced pendulum: (1 + j) θ̇²/2 − cos θ + κθ²/2.
+    /// Mechanical energy per m g l of the unforced pendulum: (1 + j) θ̇²/2 − cos θ + κ·stretch²/2
+    /// ([`Dimensionless::spring_stretch`]).
     pub fn energy(&self, theta: f64, theta_dot: f64) -> f64 {
         0.5 * (1.0 + self.params.j) * theta_dot * theta_dot - theta.cos()
-            + 0.5 * self.params.kappa * theta * theta
+            + 0.5 * self.params.kappa * self.params.spring_stretch(theta).powi(2)
     }
 }
 

@@ -82,6 +82,10 @@ pub struct Departures {
     /// N·m/rad.
     #[serde(default)]
     pub torsion_spring_nm_per_rad: Option<f64>,
+    /// The spring's cable hangs slack within ± this angle of the hanging position, rad, and
+    /// pulls only beyond it (a dead band in the unwrapped θ; with `torsion_spring_nm_per_rad`).
+    #[serde(default)]
+    pub cable_slack_rad: Option<f64>,
     /// The encoder's real counts per revolution while its header says 4096 (a mislabelled
     /// encoder).
     #[serde(default)]
@@ -113,6 +117,15 @@ impl Departures {
             return Some((
                 "torsion_spring_nm_per_rad",
                 "a finite stiffness ≥ 0 N·m/rad",
+            ));
+        }
+        if bad(self.cable_slack_rad, |v| v >= 0.0) {
+            return Some(("cable_slack_rad", "a finite slack ≥ 0 rad"));
+        }
+        if self.cable_slack_rad.is_some() && self.torsion_spring_nm_per_rad.is_none() {
+            return Some((
+                "cable_slack_rad",
+                "a slack beside a torsion_spring_nm_per_rad (alone it has no cable to slacken)",
             ));
         }
         if bad(self.encoder_cpr_true, |v| v >= 1.0) {
@@ -583,6 +596,7 @@ fn synthesize_run(
     let mut d = phys.to_dimensionless();
     if let Some(k) = case.truth.departures.torsion_spring_nm_per_rad {
         d.kappa = k / (phys.m_kg * phys.g_m_s2 * phys.l_m);
+        d.kappa_slack = case.truth.departures.cable_slack_rad.unwrap_or(0.0);
     }
     if let Some(spread) = case.truth.departures.mu_run_spread {
         d.m_coulomb *= 1.0 + rng.random_range(-spread..=spread);
