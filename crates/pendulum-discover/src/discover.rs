@@ -467,16 +467,19 @@ fn per_run_mean(values: &[f64], nominal: f64) -> (f64, f64, f64) {
     (mean, half, delta_bic)
 }
 
-/// The accelerometer's own held-out view of an input effect read from it: the fall of the validate
-/// runs' squared error Σ(v − ·)² when the identify runs' value `fitted` replaces the `nominal`
-/// one, v each validate run's own reading (NaN without validate runs).
-fn sensor_heldout_gain(val: &[f64], nominal: f64, fitted: f64) -> f64 {
-    if val.is_empty() {
-        return f64::NAN;
-    }
+/// The accelerometer's own held-out view of an input effect read from it: the validate runs'
+/// squared error Σ(v − ·)² about the `nominal` value and about the identify runs' `fitted` one
+/// (v each validate run's own reading), and its fall, as (gain, before, after); the gain is NaN
+/// without validate runs.
+fn sensor_heldout(val: &[f64], nominal: f64, fitted: f64) -> (f64, f64, f64) {
     let before = val.iter().map(|v| (v - nominal).powi(2)).sum::<f64>();
     let after = val.iter().map(|v| (v - fitted).powi(2)).sum::<f64>();
-    1.0 - after / before.max(1e-300)
+    let gain = if val.is_empty() {
+        f64::NAN
+    } else {
+        1.0 - after / before.max(1e-300)
+    };
+    (gain, before, after)
 }
 
 /// The sensor view's held-out gain above which it confirms an input effect: the validate runs'
@@ -508,9 +511,7 @@ fn accel_gain_row(ctx: &Context, cfg: &DiscoverConfig) -> Option<DiagnosisRow> {
     }
     let (mean, half, delta_bic) = per_run_mean(&g_id, 1.0);
     let est = mean - 1.0;
-    let before = g_val.iter().map(|g| (g - 1.0).powi(2)).sum::<f64>();
-    let after = g_val.iter().map(|g| (g - 1.0 - est).powi(2)).sum::<f64>();
-    let gain = sensor_heldout_gain(&g_val, 1.0, mean);
+    let (gain, before, after) = sensor_heldout(&g_val, 1.0, mean);
     let excludes_zero = est - half > 0.0 || est + half < 0.0;
     let accepted = excludes_zero
         && est.abs() > ACCEL_GAIN_FLOOR
@@ -707,7 +708,7 @@ fn speed_drift_row(
     // (each run's crank track drifting as the identify runs' do) while E_θ does not rise beyond
     // its noise. A small drift barely moves the pendulum: a 3.4e-4 Hz/s drift, tracked within
     // 0.01 %, was refused on an E_θ fall of 37.5 % ± 51.9 %.
-    let sensor_gain = sensor_heldout_gain(&ev.val, 0.0, est);
+    let (sensor_gain, _, _) = sensor_heldout(&ev.val, 0.0, est);
     let held_out = gain > gain_needed || (sensor_gain > SENSOR_HELDOUT_GAIN && gain > -noise);
     row.accepted = held_out && views_agree(est, half, refit_est, screen_fits);
     row.heldout_gain = gain;
@@ -1507,8 +1508,8 @@ pub fn discover(
         // study's setting the validate runs' segments scatter by ±10–20 %, more than a dry torque
         // that μ half absorbs moves them, while their equation error tells the models apart.
         // And the other way round: the E_θ fall alone will not do where the validate runs'
-        // equation error rises (beyond its noise, or at all, below). The two views then contradict each other, and
-        // for a torque of the equation of motion (its columns exact, unlike a linearised
+        // equation error rises (beyond its noise, or at all, below). The two views then
+        // contradict each other, and for a torque of the equation of motion (its columns exact, unlike a linearised
         // offset or delay) the equation error is the direct one: a hidden k = 32 cogging
         // torque was "explained" by a k = 13 one of a quarter its size, E_θ falling 40 % on
         // the validate runs while their equation error rose 28 % (noise 26 %). Nor may that

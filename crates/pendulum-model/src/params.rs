@@ -235,15 +235,6 @@ pub struct Dimensionless {
     pub c_rate: f64,
 }
 
-impl Dimensionless {
-    /// The spring's stretch at θ: θ itself, or beyond a slack of ±`kappa_slack` what lies past
-    /// it (torque −κ·stretch, energy κ·stretch²/2).
-    #[inline]
-    pub fn spring_stretch(&self, theta: f64) -> f64 {
-        theta - theta.clamp(-self.kappa_slack, self.kappa_slack)
-    }
-}
-
 impl Default for Dimensionless {
     fn default() -> Self {
         Physical::default().to_dimensionless()
@@ -263,6 +254,13 @@ pub struct Slot {
 }
 
 impl Dimensionless {
+    /// The spring's stretch at θ: θ itself, or beyond a slack of ±`kappa_slack` what lies past
+    /// it (torque −κ·stretch, energy κ·stretch²/2).
+    #[inline]
+    pub fn spring_stretch(&self, theta: f64) -> f64 {
+        theta - theta.clamp(-self.kappa_slack, self.kappa_slack)
+    }
+
     /// A free pendulum with no damping and no base motion.
     pub fn conservative() -> Self {
         Self {
