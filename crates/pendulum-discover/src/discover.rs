@@ -1847,8 +1847,28 @@ pub fn discover(
         (None, Some(d)) if refused.is_some() => Some(d.clone()),
         _ => None,
     };
+    // A description that is a catalogue entry's own shape says so: the entry was tried and not
+    // named (a 3.4e-3 N·m constant dry torque whose trajectory refit said 1.9e-3 was described as
+    // "a step at dθ/dt = 0" of 3.3e-3 N·m, which reads as a departure outside the catalogue).
+    let twin_words = |d: &crate::sparse::Description| -> String {
+        let twin = d.catalogue_twin().and_then(|e| {
+            rows.iter()
+                .find(|r| r.effect == e && !r.accepted && r.screen_estimate.is_finite())
+        });
+        match twin {
+            Some(r) => format!(
+                "{}; this is the shape of the catalogue's `{}`, tried and not named (screen {:.3e} {}, trajectory refit {:.3e}; its row says why)",
+                d.words(&|r| view.weak_runs[r].0.clone()),
+                r.effect,
+                r.screen_estimate,
+                r.unit,
+                r.refit_estimate
+            ),
+            None => d.words(&|r| view.weak_runs[r].0.clone()),
+        }
+    };
     let structure = match (confirmed_description, &description) {
-        (Some(d), _) => Some(d.words(&|r| view.weak_runs[r].0.clone())),
+        (Some(d), _) => Some(twin_words(d)),
         // A refused candidate already says a departure is there; describe it even where the
         // validate runs cannot confirm the description's shape, and say so.
         (None, Some(d)) if refused.is_some() => Some(format!(

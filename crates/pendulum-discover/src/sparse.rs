@@ -132,6 +132,15 @@ pub const LIBRARY: [Term; 22] = [
     ),
 ];
 
+/// Library terms that are, alone, a catalogue effect's own torque shape (the effect's regressor
+/// is the same function of the same variable): a description of that one term is the catalogue
+/// entry's shape, and the words say so, with why the entry was not named.
+pub const CATALOGUE_TWINS: [(&str, &str); 3] = [
+    ("θ̇", "viscous_linear"),
+    ("θ̇|θ̇|", "viscous_quadratic"),
+    ("sgn θ̇", "coulomb_constant"),
+];
+
 /// Terms that enter only with their main effect: a torque growing with time from the aligned
 /// t = 0 (an arbitrary origin: the rig has run since power-on) is t sgn θ̇ *and* sgn θ̇. Alone,
 /// t sgn θ̇ forces the torque through zero at t = 0, and its slope then takes what the
@@ -238,6 +247,18 @@ pub struct Description {
 }
 
 impl Description {
+    /// The catalogue effect whose shape this description is, when it is one term with a twin in
+    /// [`CATALOGUE_TWINS`].
+    pub fn catalogue_twin(&self) -> Option<&'static str> {
+        match self.terms.as_slice() {
+            [(j, _, _)] => CATALOGUE_TWINS
+                .iter()
+                .find(|(term, _)| *term == LIBRARY[*j].name)
+                .map(|(_, effect)| *effect),
+            _ => None,
+        }
+    }
+
     /// Words a mechanic can act on.
     pub fn words(&self, run_names: &dyn Fn(usize) -> String) -> String {
         let mut shapes: Vec<&str> = Vec::new();
@@ -796,5 +817,22 @@ mod tests {
         // Nothing to scale: no loss among the columns.
         let off = crate::weak::observation_column().expect("an offset column");
         assert!(run_spread(&rows, &spread, &[off], &[1e-3], &is_id).is_none());
+    }
+
+    /// Each twin names a library term and a catalogue effect that follows the term's variable.
+    #[test]
+    fn catalogue_twins_are_library_terms_of_the_effects_variable() {
+        for (term, effect) in CATALOGUE_TWINS {
+            let t = LIBRARY
+                .iter()
+                .find(|t| t.name == term)
+                .unwrap_or_else(|| panic!("no library term {term}"));
+            let e = pendulum_model::effects::by_name(effect)
+                .unwrap_or_else(|| panic!("no catalogue effect {effect}"));
+            assert!(
+                e.follows().contains(&t.variable),
+                "{effect} does not follow {term}"
+            );
+        }
     }
 }
