@@ -284,6 +284,30 @@ fn slack_cable_is_unexplained_and_follows_the_angle() {
     }
 }
 
+/// An encoder decoded at twice its counts (8192 a turn under a 4096 header, the quadrature
+/// mistake): every angle is doubled, far outside what a small correction describes. Nothing may
+/// be named and `unexplained` must speak. Measured: on two kept CLI designs of the growth test
+/// nothing was named and nothing said, μ pinned at its search bound 0.25 (now: "the base
+/// model's own fit is cut short by its search range"); on this test's first draw nothing was
+/// said either, with no bound hit but a chaotic validate run whose segment predictions missed
+/// 62 % of how far its angle moved (now: "the model in hand does not follow runs r08"; 0.06–8.5 %
+/// on campaigns with nothing hidden or with run-to-run friction).
+#[test]
+fn encoder_at_twice_its_counts_is_unexplained() {
+    let mut r = rng(7);
+    for case in 0..2 {
+        let (b, mu) = (r.random_range(0.3..0.7), r.random_range(0.08..0.2));
+        let s = discover_with(7700 + case, b, mu, "encoder_cpr_true = 8192");
+        let d = &s.discovery;
+        assert!(
+            d.accepted().is_empty(),
+            "case {case}: named {:?} for an encoder at twice its counts",
+            d.accepted()
+        );
+        assert!(d.unexplained.is_some(), "case {case}: nothing said");
+    }
+}
+
 /// A departure outside its physical range is refused when the case is read, naming its key: a
 /// negative friction growth (or spring) would feed energy in, which no rig does.
 #[test]

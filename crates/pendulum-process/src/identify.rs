@@ -466,11 +466,32 @@ pub fn identify(
     })
 }
 
-/// The fitted parameters that sit at a search bound (within 0.1 % of the bounds' span), in
-/// words: an estimate pinned there is the bound's, not the data's (an encoder offset at its
-/// ±0.05 rad limit, ω0 at ±5 % of the swings' estimate). A damping term at its lower bound 0 is
-/// said too: the fit does not use it, which is a finding, not a measured zero.
-pub fn params_at_bounds(runs: &[PreparedRun], out: &FitOutcome) -> Vec<String> {
+/// A fitted parameter that sits at a search bound (see [`bound_hits`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct BoundHit {
+    /// The parameter's name and unit ("1" or "" for a ratio).
+    pub name: &'static str,
+    pub unit: &'static str,
+    pub value: f64,
+    /// "lower" or "upper", and the bound.
+    pub side: &'static str,
+    pub bound: f64,
+    pub lo: f64,
+    pub hi: f64,
+}
+
+impl BoundHit {
+    /// A damping term at its lower bound 0: the fit does not use it (a finding, not a measured
+    /// 0). Any other hit cut the fit short.
+    pub fn unused(&self) -> bool {
+        self.side == "lower" && self.bound == 0.0
+    }
+}
+
+/// The fitted parameters that sit at a search bound (within 0.1 % of the bounds' span; a lower
+/// bound 0 within 1e-6 of it): an estimate pinned there is the bound's, not the data's (an
+/// encoder offset at its ±0.05 rad limit, ω0 at ±5 % of the swings' estimate).
+pub fn bound_hits(runs: &[PreparedRun], out: &FitOutcome) -> Vec<BoundHit> {
     let objective = StudyObjective {
         runs,
         spec: &out.spec,
@@ -482,7 +503,7 @@ pub fn params_at_bounds(runs: &[PreparedRun], out: &FitOutcome) -> Vec<String> {
         order: Default::default(),
     };
     let bounds = objective.bounds_vec();
-    let mut notes = Vec::new();
+    let mut hits = Vec::new();
     for ((p, &v), &(lo, hi)) in out.spec.params.iter().zip(&out.params).zip(&bounds) {
         let tol = 1e-3 * (hi - lo);
         // A damping term's lower bound 0 is where a term the fit does not use ends up, to the
@@ -496,30 +517,77 @@ pub fn params_at_bounds(runs: &[PreparedRun], out: &FitOutcome) -> Vec<String> {
         } else {
             None
         };
-        let Some((side, b)) = at else {
-            continue;
-        };
-        let what = if side == "lower" && b == 0.0 {
-            "the fit does not use it (the estimate is the bound, not a measured 0)".to_string()
-        } else {
-            format!(
-                "the estimate is the bound's, not the data's: the search range [{lo:.4}, {hi:.4}] {} \
-                 cut the fit short (or the model lacks what the fit tries to absorb with it)",
-                p.unit()
-            )
-        };
-        // A dimensionless ratio's unit is "1": the number alone reads better.
-        let unit = match p.unit() {
-            "1" | "" => String::new(),
-            u => format!(" {u}"),
-        };
-        notes.push(format!(
-            "fit {}: {} = {v:.4e}{unit} sits at its {side} bound {b:.4}: {what}",
-            out.spec.name,
-            p.name(),
-        ));
+        if let Some((side, bound)) = at {
+            hits.push(BoundHit {
+                name: p.name(),
+                unit: p.unit(),
+                value: v,
+                side,
+                bound,
+                lo,
+                hi,
+            });
+        }
     }
-    notes
+    hits
+}
+
+/// [`bound_hits`] in words. A damping term at its lower bound 0 is said too: the fit does not
+/// use it, which is a finding, not a measured zero.
+pub fn params_at_bounds(runs: &[PreparedRun], out: &FitOutcome) -> Vec<String> {
+    bound_hits(runs, out)
+        .iter()
+        .map(|h| {
+            let what = if h.unused() {
+                "the fit does not use it (the estimate is the bound, not a measured 0)".to_string()
+            } else {
+                format!(
+                    "the estimate is the bound's, not the data's: the search range [{:.4}, {:.4}] {} \
+                     cut the fit short (or the model lacks what the fit tries to absorb with it)",
+                    h.lo, h.hi, h.unit
+                )
+            };
+            // A dimensionless ratio's unit is "1": the number alone reads better.
+            let unit = match h.unit {
+                "1" | "" => String::new(),
+                u => format!(" {u}"),
+            };
+            format!(
+                "fit {}: {} = {:.4e}{unit} sits at its {} bound {:.4}: {what}",
+                out.spec.name, h.name, h.value, h.side, h.bound,
+            )
+        })
+        .collect()
+}
+
+/// Mean motion per sample, rad, below which a run is at rest for [`misfit_ratio`]: about seven
+/// encoder counts, above the encoder's resolution and zeroing error.
+pub const MISFIT_MOTION_MIN_RAD: f64 = 0.01;
+
+/// How far a model's predictions miss against how far the angle moves: the run's E_θ (Σ|θ̂ − θ|
+/// over its samples, each multiple-shooting segment started from the measured state) over
+/// Σ|θ − θ at its segment's start|, what predicting "the angle stays where the segment started"
+/// would miss. Near 0 for a model that follows the run; near 1 or above for one that does no
+/// better than standing still. `None` for a run that hardly moves (mean motion under
+/// [`MISFIT_MOTION_MIN_RAD`]).
+pub fn misfit_ratio(run: &PreparedRun, e_theta: f64) -> Option<f64> {
+    let first = *run.theta.first()?;
+    let mut starts = run.restarts.iter().peekable();
+    let mut start = first;
+    let mut motion = 0.0;
+    for (k, th) in run.theta.iter().enumerate() {
+        while let Some((i, y)) = starts.peek() {
+            if *i <= k {
+                start = y[0];
+                starts.next();
+            } else {
+                break;
+            }
+        }
+        motion += (th - start).abs();
+    }
+    let n = run.theta.len() as f64;
+    (motion / n >= MISFIT_MOTION_MIN_RAD).then(|| e_theta / motion)
 }
 
 /// Free decays share one ω0 in a fit. When the runs' own ω0 (from their swing periods, good to
