@@ -1272,6 +1272,45 @@ mod tests {
         assert!(seen.contains(&SteadyClass::Rest) && seen.iter().any(|c| c.is_rotation()));
     }
 
+    /// The misfit ratio: a model that is the run's own truth follows it (its segments' E_θ is a
+    /// small share of how far the angle moves), a prediction that stands still at each
+    /// segment's start scores exactly 1 (counted by hand over the 50-sample segments), and a run
+    /// at rest has no ratio.
+    #[test]
+    fn misfit_ratio_tells_a_following_model_from_standing_still() {
+        let r = run(1.75, STUDY, [1.0, -1.5]);
+        let spec = ModelSpec::reference();
+        let objective = StudyObjective {
+            runs: std::slice::from_ref(&r),
+            spec: &spec,
+            kappa: 1.0,
+            sim: SimOptions::with_tol(1e-8),
+            ic_halfwidth: 0.1,
+            fixed_params: None,
+            penalty: false,
+            order: WorkOrder::default(),
+        };
+        let mut x = STUDY.to_vec();
+        x.extend_from_slice(&r.ic_est);
+        let e = objective.evaluate(&x).per_run_e[0];
+        let ratio = crate::identify::misfit_ratio(&r, e).expect("a moving run");
+        assert!(ratio < 0.01, "the truth misses {ratio}");
+        let still: f64 = r
+            .theta
+            .iter()
+            .enumerate()
+            .map(|(k, th)| (th - r.theta[50 * (k / 50)]).abs())
+            .sum();
+        let one = crate::identify::misfit_ratio(&r, still).unwrap();
+        assert!((one - 1.0).abs() < 1e-12, "standing still scores {one}");
+        let mut rest = r.clone();
+        rest.theta = vec![0.01; rest.theta.len()];
+        for (_, y) in &mut rest.restarts {
+            *y = [0.01, 0.0];
+        }
+        assert!(crate::identify::misfit_ratio(&rest, 1.0).is_none());
+    }
+
     /// A bounded cost is the unbounded one, or a lower bound above the bound when that is
     /// above the bound: the early abandon cannot change a selection.
     #[test]
