@@ -1935,30 +1935,27 @@ pub fn discover(
     } else {
         Vec::new()
     };
-    let structure = if not_followed.is_empty() {
-        structure
-    } else {
-        let words = format!(
-            "the model in hand does not follow runs {}: restarted from the measured state, its predictions miss by that share of how far the angle moves (a departure far beyond a small correction: the angle's scale, the rig's geometry)",
-            not_followed.join(", ")
-        );
+    // Each failure of the model in hand, when there is one, leads the words.
+    let lead = |structure: Option<String>, items: &[String], words: &dyn Fn(String) -> String| {
+        if items.is_empty() {
+            return structure;
+        }
+        let w = words(items.join(", "));
         Some(match structure {
-            Some(s) => format!("{words}; {s}"),
-            None => words,
+            Some(s) => format!("{w}; {s}"),
+            None => w,
         })
     };
-    let structure = if cut_short.is_empty() {
-        structure
-    } else {
-        let words = format!(
-            "the base model's own fit is cut short by its search range ({}): the model in hand does not follow these runs (a departure it lacks, or damping beyond the range)",
-            cut_short.join(", ")
-        );
-        Some(match structure {
-            Some(s) => format!("{words}; {s}"),
-            None => words,
-        })
-    };
+    let structure = lead(structure, &not_followed, &|runs| {
+        format!(
+            "the model in hand does not follow runs {runs}: restarted from the measured state, its predictions miss by that share of how far the angle moves (a departure far beyond a small correction: the angle's scale, the rig's geometry)"
+        )
+    });
+    let structure = lead(structure, &cut_short, &|hits| {
+        format!(
+            "the base model's own fit is cut short by its search range ({hits}): the model in hand does not follow these runs (a departure it lacks, or damping beyond the range)"
+        )
+    });
     let unexplained = match (refused, structure) {
         (Some(r), Some(s)) => Some(format!("{r}; {s}")),
         (Some(r), None) => Some(r),

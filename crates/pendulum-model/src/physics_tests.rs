@@ -36,19 +36,22 @@ fn turning_points(theta: &[f64], theta_dot: &[f64]) -> Vec<f64> {
     out
 }
 
+/// The largest departure of a trajectory's energy from `e0`.
+fn energy_drift(m: &Model, tr: &crate::Trajectory, e0: f64) -> f64 {
+    tr.theta
+        .iter()
+        .zip(&tr.theta_dot)
+        .map(|(&a, &w)| (m.energy(a, w) - e0).abs())
+        .fold(0.0, f64::max)
+}
+
 #[test]
 fn energy_conserved_over_100_swings() {
     let m = free(0.0, 0.0, 0.0);
     let opts = SimOptions::with_tol(1e-12);
     // Amplitude 1 rad: period ≈ 6.70, so 100 swings ≈ 670 time units.
     let tr = simulate(&m, &opts, [1.0, 0.0], 0.0, 680.0, 0.05).unwrap();
-    let e0 = m.energy(1.0, 0.0);
-    let worst = tr
-        .theta
-        .iter()
-        .zip(&tr.theta_dot)
-        .map(|(&a, &w)| (m.energy(a, w) - e0).abs())
-        .fold(0.0, f64::max);
+    let worst = energy_drift(&m, &tr, m.energy(1.0, 0.0));
     assert!(worst < 1e-8, "energy drift {worst}");
     let swings = turning_points(&tr.theta, &tr.theta_dot).len() / 2;
     assert!(swings >= 100, "{swings} swings");
@@ -66,13 +69,7 @@ fn energy_conserved_with_a_slack_cable() {
     let m = Model::with_excitation(d, Excitation::None);
     let opts = SimOptions::with_tol(1e-12);
     let tr = simulate(&m, &opts, [1.2, 0.0], 0.0, 300.0, 0.05).unwrap();
-    let e0 = m.energy(1.2, 0.0);
-    let worst = tr
-        .theta
-        .iter()
-        .zip(&tr.theta_dot)
-        .map(|(&a, &w)| (m.energy(a, w) - e0).abs())
-        .fold(0.0, f64::max);
+    let worst = energy_drift(&m, &tr, m.energy(1.2, 0.0));
     assert!(worst < 1e-8, "energy drift {worst}");
     let swings = turning_points(&tr.theta, &tr.theta_dot).len() / 2;
     assert!(swings >= 50, "{swings} swings");
