@@ -103,12 +103,7 @@ fn assert_found(s: &DiscoverSummary, effect: &str, truth: f64, rel: f64, abs: f6
     }
     let accepted = s.discovery.accepted();
     assert_eq!(accepted, vec![effect], "accepted {accepted:?}");
-    let row = s
-        .discovery
-        .rows
-        .iter()
-        .find(|r| r.effect == effect)
-        .unwrap();
+    let row = s.discovery.row(effect).unwrap();
     let err = (row.estimate - truth).abs();
     eprintln!(
         "found {effect}: estimate {:.4e} vs truth {truth:.4e} ({:+.1} %), interval [{:.4e}, {:.4e}], held-out gain {:.1} %",
@@ -229,12 +224,7 @@ fn regression_issue_12_finds_motor_cogging() {
     );
     eprintln!("hidden cogging: T_p {tp:.4e} N·m, k = {k}, φ_p {phi:.3}");
     assert_found(&s, "position_torque", tp, 0.1, 0.0);
-    let row = s
-        .discovery
-        .rows
-        .iter()
-        .find(|r| r.effect == "position_torque")
-        .unwrap();
+    let row = s.discovery.row("position_torque").unwrap();
     assert!(row.note.starts_with(&format!("k = {k};")), "{}", row.note);
     // params.parquet carries the lobe count, which no fit varies, so a reader (validate, replay,
     // the maps) rebuilds the same model: it was read back as k = 1.
@@ -288,11 +278,7 @@ fn survey_issue_5_constant_dry_torque_hit_rate() {
             &format!("coulomb_constant_t_c_nm = {tc}"),
         );
         let accepted = s.discovery.accepted();
-        let row = s
-            .discovery
-            .rows
-            .iter()
-            .find(|r| r.effect == "coulomb_constant");
+        let row = s.discovery.row("coulomb_constant");
         let est = row.map_or(f64::NAN, |r| r.estimate);
         if let Some(r) = row {
             eprintln!(
@@ -396,12 +382,7 @@ fn assert_pair_found(tag: u64, seed: u64, e1: &str, e2: &str) {
     want.sort_unstable();
     assert_eq!(accepted, want);
     for (effect, truth) in [(e1, t1), (e2, t2)] {
-        let row = s
-            .discovery
-            .rows
-            .iter()
-            .find(|r| r.effect == effect)
-            .unwrap();
+        let row = s.discovery.row(effect).unwrap();
         let err = (row.estimate - truth).abs();
         eprintln!(
             "pair {e1}+{e2}: {effect} estimate {:.4e} vs truth {truth:.4e} ({:+.1} %)",
@@ -466,12 +447,7 @@ fn issue_14_second_look_names_the_breakaway_not_a_constant_dry_torque() {
         "{:#?}",
         s.discovery.rows
     );
-    let row = s
-        .discovery
-        .rows
-        .iter()
-        .find(|r| r.effect == "stribeck")
-        .expect("a stribeck row");
+    let row = s.discovery.row("stribeck").expect("a stribeck row");
     assert!(row.note.contains("second look"), "{}", row.note);
     assert!(row.estimate > 0.0 && row.heldout_gain > 0.0, "{row:?}");
 }
@@ -584,12 +560,7 @@ fn small_speed_drift_is_confirmed_by_the_validate_runs_crank_tracks() {
         ["speed_drift"],
         "hidden {truth:.4e} Hz/s"
     );
-    let row = s
-        .discovery
-        .rows
-        .iter()
-        .find(|r| r.effect == "speed_drift")
-        .expect("a speed_drift row");
+    let row = s.discovery.row("speed_drift").expect("a speed_drift row");
     assert!(
         (row.estimate - truth).abs() < 0.01 * truth.abs(),
         "{:.4e} against {truth:.4e} Hz/s",
@@ -615,11 +586,7 @@ fn a_description_in_a_catalogue_entrys_shape_says_which() {
     let s = discover(5402, base, a, b, mu, &spec);
     let d = &s.discovery;
     if d.accepted() == ["coulomb_constant"] {
-        let row = d
-            .rows
-            .iter()
-            .find(|r| r.effect == "coulomb_constant")
-            .unwrap();
+        let row = d.row("coulomb_constant").unwrap();
         assert!((row.estimate - truth).abs() < 0.1 * truth, "{row:?}");
         return;
     }
@@ -685,7 +652,7 @@ fn survey_issue_5_every_effect() {
             let (truth, spec, base, a, b, mu) = draw_scaled(effect, &mut r, size_scale);
             let s = discover(5000 + 100 * e_idx as u64 + k, base, a, b, mu, &spec);
             let accepted = s.discovery.accepted();
-            let row = s.discovery.rows.iter().find(|r| r.effect == *effect);
+            let row = s.discovery.row(effect);
             let est = row.map_or(f64::NAN, |r| r.estimate);
             // Issue 12's bar: named alone, estimate within 10 % of the truth.
             let ok_est = (est - truth).abs() <= 0.10 * truth.abs();
@@ -733,13 +700,7 @@ fn survey_issue_5_every_effect() {
         let mut want = vec![*e1, *e2];
         want.sort_unstable();
         pair_hits += usize::from(accepted == want);
-        let est = |e: &str| {
-            s.discovery
-                .rows
-                .iter()
-                .find(|r| r.effect == e)
-                .map_or(f64::NAN, |r| r.estimate)
-        };
+        let est = |e: &str| s.discovery.row(e).map_or(f64::NAN, |r| r.estimate);
         eprintln!(
             "survey-pair {e1}+{e2}: truths {t1:.4e}, {t2:.4e}; estimates {:.4e}, {:.4e}; accepted={accepted:?}",
             est(e1),

@@ -150,6 +150,11 @@ impl Discovery {
             .map(|r| r.effect.as_str())
             .collect()
     }
+
+    /// The row of a catalogue effect (or `unexplained`), if it was tried.
+    pub fn row(&self, effect: &str) -> Option<&DiagnosisRow> {
+        self.rows.iter().find(|r| r.effect == effect)
+    }
 }
 
 /// Exact corrections of the measured motion for accepted effects that enter the equation of
