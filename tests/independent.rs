@@ -77,13 +77,22 @@ fn check(name: &str, base: Base) {
         );
         return;
     };
-    let dir = root.join(name);
-    let truth: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(root.join(format!("{name}.truth.json"))).unwrap())
-            .unwrap();
+    if let Err(why) = judge(&root.join(name), &truth_of(&root, name), base) {
+        panic!("{name}: {why}");
+    }
+}
+
+fn truth_of(root: &Path, name: &str) -> serde_json::Value {
+    serde_json::from_slice(&std::fs::read(root.join(format!("{name}.truth.json"))).unwrap())
+        .unwrap()
+}
+
+/// Runs `discover` on the campaign in `dir` and applies the README's rule: `Err` says what was
+/// wrong (the accepted set, or an estimate outside its tolerance).
+fn judge(dir: &Path, truth: &serde_json::Value, base: Base) -> Result<(), String> {
     let out = tempfile::tempdir().unwrap();
     let s = run(&DiscoverJob {
-        input: dir,
+        input: dir.to_path_buf(),
         out: out.path().join("out"),
         base,
         pipeline: None,
@@ -99,7 +108,10 @@ fn check(name: &str, base: Base) {
         .into_iter()
         .map(String::from)
         .collect();
-    assert_eq!(accepted, expected(&truth, base), "{name}: accepted");
+    let want = expected(truth, base);
+    if accepted != want {
+        return Err(format!("accepted {accepted:?}, expected {want:?}"));
+    }
     let effects = truth["effects"].as_array().unwrap();
     for e in &accepted {
         let Some((key, absolute, tol)) = tolerance(e) else {
@@ -109,17 +121,145 @@ fn check(name: &str, base: Base) {
             .iter()
             .find(|v| v["name"] == e.as_str())
             .and_then(|v| v[key].as_f64())
-            .unwrap_or_else(|| panic!("{name}: no truth {key} for {e}"));
-        let row = s.discovery.rows.iter().find(|r| &r.effect == e).unwrap();
+            .unwrap_or_else(|| panic!("no truth {key} for {e}"));
+        let row = s.discovery.row(e).unwrap();
         let err = (row.estimate - t).abs();
         let err = if absolute { err } else { err / t.abs() };
-        eprintln!("{name}: {e} {:.4e} vs truth {t:.4e}", row.estimate);
-        assert!(
-            err <= tol,
-            "{name}: {e} estimate {} vs truth {t}",
-            row.estimate
-        );
+        eprintln!("{e} {:.4e} vs truth {t:.4e}", row.estimate);
+        if err > tol {
+            return Err(format!("{e} estimate {} vs truth {t}", row.estimate));
+        }
     }
+    Ok(())
+}
+
+/// A copy of the independent campaign `src` in `dst` with another design drawn from its own
+/// runs: `validate` (indices into its `[[run]]` list) become the validate runs, the rest of
+/// `keep` the identify runs, and runs outside `keep` are left out (their files not copied).
+fn redesign(src: &Path, dst: &Path, keep: &[usize], validate: &[usize]) {
+    let text = std::fs::read_to_string(src.join("campaign.toml")).unwrap();
+    let mut doc: toml::Table = toml::from_str(&text).unwrap();
+    let runs = doc["run"].as_array().unwrap().clone();
+    let mut kept = Vec::new();
+    std::fs::create_dir_all(dst).unwrap();
+    for (i, r) in runs.into_iter().enumerate() {
+        if !keep.contains(&i) {
+            continue;
+        }
+        let mut r = r.as_table().unwrap().clone();
+        let role = if validate.contains(&i) {
+            "validate"
+        } else {
+            "identify"
+        };
+        r.insert("role".into(), role.into());
+        let file = r["file"].as_str().unwrap();
+        std::fs::copy(src.join(file), dst.join(file)).unwrap();
+        kept.push(toml::Value::Table(r));
+    }
+    doc.insert("run".into(), toml::Value::Array(kept));
+    std::fs::write(dst.join("campaign.toml"), toml::to_string(&doc).unwrap()).unwrap();
+}
+
+/// Survey (slow, by hand with `--ignored`): the independent campaigns under designs their
+/// simulator did not choose. Each campaign (and `i11` with `--base dry`) is run `RESAMPLE_N`
+/// times (default 2) with a drawn identify/validate split of all its runs, and `RESAMPLE_N`
+/// times with only 3 drawn identify and 2 drawn validate runs; the README's rule must hold on
+/// every one. Data the project did not make, in designs no one tuned on. Seeded
+/// (`RESAMPLE_SEED`, default 7).
+#[test]
+#[ignore = "survey for issue 12: 14 independent campaigns × 2 RESAMPLE_N redesigns; RESAMPLE_N=2 is ~15 minutes on 2 cores"]
+fn survey_independent_campaigns_redesigned() {
+    use rand::seq::SliceRandom;
+    use rand::SeedableRng;
+    let Some(root) = independent_dir() else {
+        eprintln!(
+            "SKIPPED: ../shared/data/independent is absent (issue 12's independent campaigns)"
+        );
+        return;
+    };
+    let env = |k: &str, d: u64| {
+        std::env::var(k)
+            .ok()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(d)
+    };
+    let n = env("RESAMPLE_N", 2);
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(env("RESAMPLE_SEED", 7));
+    let mut names: Vec<String> = std::fs::read_dir(&root)
+        .unwrap()
+        .filter_map(|e| {
+            let e = e.unwrap();
+            e.path()
+                .is_dir()
+                .then(|| e.file_name().into_string().unwrap())
+        })
+        .collect();
+    names.sort();
+    let mut cases = Vec::new();
+    for name in &names {
+        let doc: toml::Table = toml::from_str(
+            &std::fs::read_to_string(root.join(name).join("campaign.toml")).unwrap(),
+        )
+        .unwrap();
+        let runs = doc["run"].as_array().unwrap();
+        let role = |r: &str| -> Vec<usize> {
+            (0..runs.len())
+                .filter(|&i| runs[i]["role"].as_str() == Some(r))
+                .collect()
+        };
+        let (mut ids, mut vals) = (role("identify"), role("validate"));
+        let mut bases = vec![Base::Reference];
+        if name.starts_with("i11") {
+            bases.push(Base::Dry);
+        }
+        for k in 0..n {
+            // All runs, another split (as many validate runs as the campaign had).
+            let mut all: Vec<usize> = (0..runs.len()).collect();
+            all.shuffle(&mut rng);
+            let split = (all.clone(), all[..vals.len()].to_vec());
+            // Fewer runs: 3 identify and 2 validate, drawn from the campaign's own roles.
+            ids.shuffle(&mut rng);
+            vals.shuffle(&mut rng);
+            let few: Vec<usize> = ids[..3].iter().chain(&vals[..2]).copied().collect();
+            let small = (few, vals[..2].to_vec());
+            for (tag, (keep, val)) in [("split", split), ("few", small)] {
+                for &base in &bases {
+                    cases.push((
+                        name.clone(),
+                        format!("{tag}{k}"),
+                        keep.clone(),
+                        val.clone(),
+                        base,
+                    ));
+                }
+            }
+        }
+    }
+    // One after another: discover parallelises inside (an outer rayon loop around it stalled
+    // on a one-thread pool).
+    let results: Vec<(String, Result<(), String>)> = cases
+        .iter()
+        .map(|(name, tag, keep, val, base)| {
+            let dir = tempfile::tempdir().unwrap();
+            redesign(&root.join(name), dir.path(), keep, val);
+            let label = format!("{name} {tag} keep={keep:?} validate={val:?} base={base:?}");
+            let r = judge(dir.path(), &truth_of(&root, name), *base);
+            eprintln!(
+                "redesigned {label}: {}",
+                r.as_ref()
+                    .map_or_else(|e| format!("WRONG {e}"), |()| "RIGHT".into())
+            );
+            (label, r)
+        })
+        .collect();
+    let wrong: Vec<_> = results.iter().filter(|(_, r)| r.is_err()).collect();
+    eprintln!(
+        "redesigned independent campaigns: right on {} of {}",
+        results.len() - wrong.len(),
+        results.len()
+    );
+    assert!(wrong.is_empty(), "{wrong:#?}");
 }
 
 macro_rules! independent {

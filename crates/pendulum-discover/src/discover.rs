@@ -435,7 +435,7 @@ fn trajectory_substitution(
             .iter()
             .zip(&spec.params)
             .map(|(v, q)| {
-                let (lo, hi) = q.bounds();
+                let (lo, hi) = spec.range(*q);
                 v.clamp(lo, hi)
             })
             .collect();
@@ -1102,7 +1102,7 @@ impl Problem for ParamsOnly<'_> {
             .iter()
             .enumerate()
             .filter(|(i, _)| Some(*i) != skip)
-            .map(|(_, p)| p.bounds())
+            .map(|(_, p)| self.inner.spec.range(*p))
             .collect()
     }
     fn cost(&self, x: &[f64], bound: f64) -> Cost {
@@ -1433,7 +1433,7 @@ pub fn discover(
                 corr,
             ));
         }
-        let (spec, mut news) = extend(&current.spec, c, &fit);
+        let (mut spec, mut news) = extend(&current.spec, c, &fit);
         // Where the refit holds the effect's size: its own first parameter, or the reference
         // parameter a switch changes (μ for bearing_load_base_accel).
         let size_index = effect
@@ -1476,6 +1476,10 @@ pub fn discover(
             if let Some(i) = size_index {
                 x0[i] = est.max(0.0);
             }
+        }
+        // Every start inside its search range (the screen's values may lie past the catalogue's).
+        for (&p, &v) in spec.params.clone().iter().zip(&x0) {
+            spec.hold(p, v);
         }
         let tails = usize::from(sets_sticking_capacity(&c.effect));
         let (traj_runs, traj_ics) = moving_runs(&id_runs, &ics, tails == 1);

@@ -557,6 +557,7 @@ pub fn read_params(path: &Path, model: Option<&str>) -> Result<FitOutcome, JobEr
                 name: name.clone(),
                 params: base.params.clone(),
                 fixed: Effects::default(),
+                ranges: Default::default(),
             };
             let given = |p: FitParam| get(p.name()).is_some_and(|v| !v.is_nan());
             // One column per refitted parameter of the catalogue, in its order.
@@ -587,6 +588,10 @@ pub fn read_params(path: &Path, model: Option<&str>) -> Result<FitOutcome, JobEr
                         .ok_or_else(|| bad(format!("model {name}: no column {}", p.name())))
                 })
                 .collect::<Result<Vec<f64>, _>>()?;
+            // A fit may have widened a search range past the catalogue's: its values hold.
+            for (&p, &v) in spec.params.clone().iter().zip(&params) {
+                spec.hold(p, v);
+            }
             return Ok(FitOutcome {
                 spec,
                 params,

@@ -19,6 +19,7 @@
 //! run's times are made dimensionless with its period-derived ω0 estimate; a trial ω0 rescales
 //! them by ω0/ω0_est (and velocities by the inverse).
 
+use std::collections::BTreeMap;
 use std::ops::ControlFlow;
 use std::sync::atomic::AtomicU64;
 use std::sync::atomic::Ordering::Relaxed;
@@ -220,6 +221,39 @@ pub struct ModelSpec {
     /// Effects held fixed (e.g. `bearing_load_base_accel = true`).
     #[serde(default)]
     pub fixed: Effects,
+    /// Search ranges widened past the catalogue's (by [`FitParam::spec_name`]; see
+    /// [`ModelSpec::widen_at_bounds`]). Empty: every parameter searches its catalogue range.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub ranges: BTreeMap<String, (f64, f64)>,
+}
+
+/// How many times a fit widens a search range its estimate was pinned at (each doubles the
+/// range's span on that side): up to 8 times the catalogue's span.
+pub const MAX_WIDENINGS: usize = 3;
+
+#[derive(Clone, Copy)]
+enum Side {
+    Lower,
+    Upper,
+}
+
+/// `range` of `p` widened on `side`: the span doubled that way (a positive lower end halved),
+/// or `None` where that end is physics (0 of a range that starts or ends there) or the range
+/// has reached 2^[`MAX_WIDENINGS`] times the catalogue's span (a positive lower end, 1/2^… of
+/// the catalogue's).
+fn widened_range(p: FitParam, (lo, hi): (f64, f64), side: Side) -> Option<(f64, f64)> {
+    let (lo0, hi0) = p.bounds();
+    let cap = f64::from(1u32 << MAX_WIDENINGS);
+    let span = hi - lo;
+    let new = match side {
+        Side::Upper if hi != 0.0 => (lo, hi + span),
+        Side::Lower if lo > 0.0 => (lo / 2.0, hi),
+        Side::Lower if lo < 0.0 => (lo - span, hi),
+        _ => return None,
+    };
+    let too_wide = new.1 - new.0 > cap * (hi0 - lo0) * (1.0 + 1e-9);
+    let too_low = lo0 > 0.0 && new.0 < lo0 / cap * (1.0 - 1e-9);
+    (!too_wide && !too_low).then_some(new)
 }
 
 impl ModelSpec {
@@ -229,6 +263,78 @@ impl ModelSpec {
             name: "reference".into(),
             params: vec![FitParam::A, FitParam::B, FitParam::Mu],
             fixed: Effects::default(),
+            ranges: BTreeMap::new(),
+        }
+    }
+
+    /// The search range of `p` in this model: widened, or the catalogue's ([`FitParam::bounds`]).
+    pub fn range(&self, p: FitParam) -> (f64, f64) {
+        self.ranges
+            .get(p.spec_name())
+            .copied()
+            .unwrap_or_else(|| p.bounds())
+    }
+
+    /// Widens the search range of each parameter whose value in `x` (one per [`Self::params`])
+    /// sits at an end of it that is a search convenience, not physics, by doubling the span on
+    /// that side; returns the names widened. A catalogue range is the search's: the data may
+    /// put a bearing's μ at 0.3 or a rotor's J at 0.03 kg·m² (the study's μ < 0.25, and twice a
+    /// survey's sizes, pinned both and neither was named). Only an end at 0 of a range that
+    /// starts there is physical (a loss, a torque's size, an inertia cannot be negative), and it
+    /// stays. The SI catalogue parameters only: ω0 and a free decay's ratios keep their
+    /// data-derived bounds, and an integer is never fitted.
+    pub fn widen_at_bounds(&mut self, x: &[f64]) -> Vec<&'static str> {
+        let mut widened = Vec::new();
+        for (&p, &v) in self.params.clone().iter().zip(x) {
+            let Some(ep) = p.effect_param() else { continue };
+            if ep.def().integer || !v.is_finite() {
+                continue;
+            }
+            let (lo, hi) = self.range(p);
+            let tol = 1e-3 * (hi - lo);
+            let side = if v >= hi - tol {
+                Side::Upper
+            } else if v <= lo + tol {
+                Side::Lower
+            } else {
+                continue;
+            };
+            if let Some(new) = widened_range(p, (lo, hi), side) {
+                self.ranges.insert(p.spec_name().into(), new);
+                widened.push(p.name());
+            }
+        }
+        widened
+    }
+
+    /// Widens the search range of `p` (as [`Self::widen_at_bounds`] would, side by side, to at
+    /// most 2^[`MAX_WIDENINGS`] times the catalogue's span) until `v` lies inside it with room to move: a tenth of the
+    /// span below the upper end and above a lower end ≤ 0, a tenth of the end's own value above a
+    /// positive lower end (halving it hardly changes the span). A refit that starts at a value
+    /// the catalogue's range does not hold (the screen's estimate of a large effect) can then
+    /// move. Never further: with a margin of a tenth of the span on the positive end too, a
+    /// stribeck v_s of 0.2 rad/s "needed" its 0.01 floor halved without end, and the refit tried
+    /// breakaways fading within 1e-11 rad/s, steps too sharp to integrate (a nothing-hidden
+    /// campaign's discover took 280 s instead of 3).
+    pub fn hold(&mut self, p: FitParam, v: f64) {
+        let Some(ep) = p.effect_param() else { return };
+        if ep.def().integer || !v.is_finite() {
+            return;
+        }
+        loop {
+            let (lo, hi) = self.range(p);
+            let span = hi - lo;
+            let side = if v > hi - 0.1 * span {
+                Side::Upper
+            } else if (lo > 0.0 && v < 1.1 * lo) || (lo < 0.0 && v < lo + 0.1 * span) {
+                Side::Lower
+            } else {
+                return;
+            };
+            match widened_range(p, (lo, hi), side) {
+                Some(new) => self.ranges.insert(p.spec_name().into(), new),
+                None => return,
+            };
         }
     }
 
@@ -238,6 +344,7 @@ impl ModelSpec {
             name: "linear".into(),
             params: vec![FitParam::B],
             fixed: Effects::default(),
+            ranges: BTreeMap::new(),
         }
     }
 
@@ -247,6 +354,7 @@ impl ModelSpec {
             name: "dry".into(),
             params: vec![FitParam::Mu],
             fixed: Effects::default(),
+            ranges: BTreeMap::new(),
         }
     }
 
@@ -295,6 +403,7 @@ impl ModelSpec {
             name: self.name.clone(),
             params,
             fixed: Effects::default(),
+            ranges: BTreeMap::new(),
         })
     }
 
@@ -1073,7 +1182,7 @@ impl Problem for StudyObjective<'_> {
                         (lo * w_est, hi * w_est)
                     }
                     _ if free && p.effect_name() == Some("encoder_offset") => (-0.05, 0.05),
-                    _ => p.bounds(),
+                    _ => self.spec.range(*p),
                 })
                 .collect()
         };
@@ -1157,6 +1266,57 @@ mod tests {
     use super::*;
 
     const STUDY: [f64; 3] = [0.0, 0.5, 0.15];
+
+    /// A value pinned at a search convenience widens that side (the span doubles); a loss at its
+    /// physical floor 0 does not; an interior value changes nothing.
+    #[test]
+    fn a_search_range_widens_where_the_data_push_and_never_past_physics() {
+        let off = FitParam::of("encoder_offset");
+        let v_s = FitParam::of("stribeck.v_s");
+        let mut spec = ModelSpec::reference();
+        spec.params.extend([off, v_s]);
+        assert_eq!(spec.range(FitParam::Mu), (0.0, 0.25));
+        // a at its floor 0 (unused), b inside, μ at the study's 0.25, the offset at −0.2 rad,
+        // v_s at its 0.01 rad/s.
+        let widened = spec.widen_at_bounds(&[0.0, 0.5, 0.25, -0.2, 0.01]);
+        assert_eq!(widened, ["mu", "encoder_offset.theta_off", "stribeck.v_s"]);
+        assert_eq!(spec.range(FitParam::A), (0.0, 1.0));
+        assert_eq!(spec.range(FitParam::B), (0.0, 1.0));
+        assert_eq!(spec.range(FitParam::Mu), (0.0, 0.5));
+        let (lo, hi) = spec.range(off);
+        assert!((lo + 0.6).abs() < 1e-12 && hi == 0.2, "{lo} {hi}");
+        // A range above 0 halves its lower end towards 0, never past it.
+        assert_eq!(spec.range(v_s), (0.005, 2.0));
+        assert!(spec.widen_at_bounds(&[0.1, 0.5, 0.3, 0.0, 0.2]).is_empty());
+        // The widened ranges are the fit's bounds, and survive a round trip through the spec's
+        // TOML (a catalogue-range spec writes no `ranges`).
+        let back: ModelSpec = toml::from_str(&toml::to_string(&spec).unwrap()).unwrap();
+        assert_eq!(back, spec);
+        assert!(!toml::to_string(&ModelSpec::reference())
+            .unwrap()
+            .contains("ranges"));
+
+        // `hold`: a start past the range (the screen's J = 0.05 kg·m² against 0.02) widens it
+        // until the start has a tenth of the span to spare; a start inside changes nothing.
+        let j = FitParam::of("extra_inertia");
+        let mut spec = ModelSpec::reference();
+        spec.params.push(j);
+        spec.hold(j, 0.01);
+        assert!(spec.ranges.is_empty());
+        spec.hold(j, 0.05);
+        assert_eq!(spec.range(j), (0.0, 0.08));
+        // A speed scale of 0.2 rad/s is well inside (0.01, 2): its floor is not moved.
+        let v_s = FitParam::of("stribeck.v_s");
+        spec.params.push(v_s);
+        spec.hold(v_s, 0.2);
+        assert_eq!(spec.range(v_s), (0.01, 2.0));
+        // At most `MAX_WIDENINGS` doublings, however far the start: then it is clamped.
+        spec.hold(j, 100.0);
+        assert_eq!(spec.range(j), (0.0, 0.16));
+        // A negative start of a non-negative size stays outside: the floor is physics.
+        spec.hold(FitParam::B, -0.1);
+        assert_eq!(spec.range(FitParam::B), (0.0, 1.0));
+    }
 
     fn rig() -> RigParams {
         RigParams {

@@ -376,8 +376,55 @@ pub fn identify(
             message: "no identify runs".into(),
         });
     }
-    let spec = spec_for_runs(cfg.spec()?, runs, "fit")?;
+    let mut spec = spec_for_runs(cfg.spec()?, runs, "fit")?;
     let free = spec.is_free_decay();
+    let dim = spec.params.len() + 2 * runs.len();
+    let np = cfg.np.unwrap_or(10 * dim).max(MIN_NP);
+    let n = spec.params.len();
+    // DE, then again from its best with any search range its best was pinned at widened (see
+    // `ModelSpec::widen_at_bounds`), at most `MAX_WIDENINGS` times. A fit whose estimates sit
+    // inside the catalogue's ranges runs once, as it always did.
+    let mut init = None;
+    let mut widenings = 0;
+    let res = loop {
+        let objective = StudyObjective {
+            runs,
+            spec: &spec,
+            kappa: cfg.kappa,
+            sim: SimOptions::with_tol(cfg.sim_tol),
+            ic_halfwidth: cfg.ic_halfwidth,
+            fixed_params: None,
+            penalty: true,
+            order: Default::default(),
+        };
+        let de = DeConfig {
+            np,
+            f: cfg.f,
+            cr: cfg.cr,
+            seed: cfg.seed,
+            max_generations: cfg.max_generations,
+            tol: cfg.tol,
+            stop_rule: cfg.stop_rule,
+            early_abandon: cfg.early_abandon,
+            init: init.take(),
+        };
+        let label = format!("fit {}", spec.name);
+        let mut driver = Driver::new(&objective, de).threads(cfg.threads);
+        if let Some(p) = progress.clone() {
+            let label = label.clone();
+            driver = driver.observer(Box::new(FnObserver::new(move |g: &GenerationStats| {
+                p(&label, g)
+            })));
+        }
+        let res = driver.run()?;
+        if widenings == crate::fit::MAX_WIDENINGS
+            || spec.widen_at_bounds(&res.best_x[..n]).is_empty()
+        {
+            break res;
+        }
+        widenings += 1;
+        init = Some(vec![res.best_x.clone()]);
+    };
     let objective = StudyObjective {
         runs,
         spec: &spec,
@@ -388,28 +435,6 @@ pub fn identify(
         penalty: true,
         order: Default::default(),
     };
-    let dim = spec.params.len() + 2 * runs.len();
-    let np = cfg.np.unwrap_or(10 * dim).max(MIN_NP);
-    let de = DeConfig {
-        np,
-        f: cfg.f,
-        cr: cfg.cr,
-        seed: cfg.seed,
-        max_generations: cfg.max_generations,
-        tol: cfg.tol,
-        stop_rule: cfg.stop_rule,
-        early_abandon: cfg.early_abandon,
-        init: None,
-    };
-    let label = format!("fit {}", spec.name);
-    let mut driver = Driver::new(&objective, de).threads(cfg.threads);
-    if let Some(p) = progress {
-        let label = label.clone();
-        driver = driver.observer(Box::new(FnObserver::new(move |g: &GenerationStats| {
-            p(&label, g)
-        })));
-    }
-    let res = driver.run()?;
     // A free decay's objective is smooth and cheap: Nelder–Mead from DE's best always runs, and
     // its point is the result when it is better (DE alone with a small budget stops short).
     let polished = if cfg.polish || free {
@@ -428,7 +453,6 @@ pub fn identify(
         _ => res.best_x.clone(),
     };
     let eval = objective.evaluate(&best_x);
-    let n = spec.params.len();
     let run_fits = runs
         .iter()
         .enumerate()
