@@ -49,6 +49,16 @@ fn identify(dir: &Path, out: &Path, model: &str) -> pendulum_jobs::outputs::Outp
     .unwrap()
 }
 
+/// The reference model's a, b, μ from an identify run's `params.parquet` (its first row).
+fn reference_params(out: &Path) -> (f64, f64, f64) {
+    let p = out.join("params.parquet");
+    (
+        column_f64(&p, "a")[0],
+        column_f64(&p, "b")[0],
+        column_f64(&p, "mu")[0],
+    )
+}
+
 /// The arrays of one column of a Parquet file, batch by batch (panics naming the file and the
 /// column when it is missing).
 fn column_arrays(path: &Path, name: &str) -> Vec<arrow_array::ArrayRef> {
@@ -113,12 +123,7 @@ fn regression_issue_4_reference_damping_recovered() {
     let truth = make_campaign(&camp, &campaign_toml(41, 0.0, 0.5, 0.15));
     let summary = identify(&camp, &out, "reference");
     eprintln!("{summary}");
-    let p = out.join("params.parquet");
-    let (a, b, mu) = (
-        column_f64(&p, "a")[0],
-        column_f64(&p, "b")[0],
-        column_f64(&p, "mu")[0],
-    );
+    let (a, b, mu) = reference_params(&out);
     assert!((b / 0.5 - 1.0).abs() < 0.10, "b = {b}");
     assert!((mu / 0.15 - 1.0).abs() < 0.10, "mu = {mu}");
     assert!(a < 0.05, "a = {a}");
@@ -307,12 +312,7 @@ fn damping_past_the_studys_search_range_is_fitted_not_pinned() {
     );
     let summary = identify(&camp, &out, "reference");
     eprintln!("{summary}");
-    let p = out.join("params.parquet");
-    let (a, b, mu) = (
-        column_f64(&p, "a")[0],
-        column_f64(&p, "b")[0],
-        column_f64(&p, "mu")[0],
-    );
+    let (a, b, mu) = reference_params(&out);
     assert!(
         mu > 1.1 * 0.25 && (mu - 0.35).abs() < 0.35 - 0.25,
         "mu = {mu}"

@@ -387,16 +387,7 @@ pub fn identify(
     let mut init = None;
     let mut widenings = 0;
     let res = loop {
-        let objective = StudyObjective {
-            runs,
-            spec: &spec,
-            kappa: cfg.kappa,
-            sim: SimOptions::with_tol(cfg.sim_tol),
-            ic_halfwidth: cfg.ic_halfwidth,
-            fixed_params: None,
-            penalty: true,
-            order: Default::default(),
-        };
+        let objective = fit_objective(runs, &spec, cfg);
         let de = DeConfig {
             np,
             f: cfg.f,
@@ -425,16 +416,7 @@ pub fn identify(
         widenings += 1;
         init = Some(vec![res.best_x.clone()]);
     };
-    let objective = StudyObjective {
-        runs,
-        spec: &spec,
-        kappa: cfg.kappa,
-        sim: SimOptions::with_tol(cfg.sim_tol),
-        ic_halfwidth: cfg.ic_halfwidth,
-        fixed_params: None,
-        penalty: true,
-        order: Default::default(),
-    };
+    let objective = fit_objective(runs, &spec, cfg);
     // A free decay's objective is smooth and cheap: Nelder–Mead from DE's best always runs, and
     // its point is the result when it is better (DE alone with a small budget stops short).
     let polished = if cfg.polish || free {
@@ -488,6 +470,24 @@ pub fn identify(
         alignments: Default::default(),
         spec,
     })
+}
+
+/// The identify fit's objective of `spec` on `runs` with `cfg`'s settings.
+fn fit_objective<'a>(
+    runs: &'a [PreparedRun],
+    spec: &'a ModelSpec,
+    cfg: &FitConfig,
+) -> StudyObjective<'a> {
+    StudyObjective {
+        runs,
+        spec,
+        kappa: cfg.kappa,
+        sim: SimOptions::with_tol(cfg.sim_tol),
+        ic_halfwidth: cfg.ic_halfwidth,
+        fixed_params: None,
+        penalty: true,
+        order: Default::default(),
+    }
 }
 
 /// A fitted parameter that sits at a search bound (see [`bound_hits`]).
@@ -1307,16 +1307,7 @@ pub fn decay_law(
         })
         .collect();
     let spec = out.spec.clone();
-    let objective = StudyObjective {
-        runs,
-        spec: &spec,
-        kappa: cfg.kappa,
-        sim: SimOptions::with_tol(cfg.sim_tol),
-        ic_halfwidth: cfg.ic_halfwidth,
-        fixed_params: None,
-        penalty: true,
-        order: Default::default(),
-    };
+    let objective = fit_objective(runs, &spec, cfg);
     let mut bounds = objective.bounds_vec();
     let n = spec.params.len();
     let mut x: Vec<f64> = out.params.clone();
