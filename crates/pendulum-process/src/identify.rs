@@ -205,6 +205,14 @@ pub struct FitConfig {
     pub polish: bool,
     /// Worker threads (None = all cores).
     pub threads: Option<usize>,
+    /// Widen a search range the fit's best is pinned at (see `ModelSpec::widen_at_bounds`).
+    /// On for `identify`, where the model is the user's and the data decide its values. Off in
+    /// discover's base fit: there the model may lack what the data hold, and a term at the end
+    /// of its range is the first sign of that, which discover reports ("cut short by its search
+    /// range") rather than let the term absorb it. Widened, the base's μ took an encoder offset
+    /// of −0.063 rad as friction (μ = 2.0, holding the pendulum off centre), and the offset was
+    /// then not named (the every-effect survey's `encoder_offset` k=1).
+    pub widen_ranges: bool,
 }
 
 impl Default for FitConfig {
@@ -226,6 +234,7 @@ impl Default for FitConfig {
             sim_tol: 1e-6,
             polish: false,
             threads: None,
+            widen_ranges: true,
         }
     }
 }
@@ -382,8 +391,8 @@ pub fn identify(
     let np = cfg.np.unwrap_or(10 * dim).max(MIN_NP);
     let n = spec.params.len();
     // DE, then again from its best with any search range its best was pinned at widened (see
-    // `ModelSpec::widen_at_bounds`), at most `MAX_WIDENINGS` times. A fit whose estimates sit
-    // inside the catalogue's ranges runs once, as it always did.
+    // `ModelSpec::widen_at_bounds`), at most `MAX_WIDENINGS` times (with `widen_ranges`). A fit
+    // whose estimates sit inside the catalogue's ranges runs once, as it always did.
     let mut init = None;
     let mut widenings = 0;
     let res = loop {
@@ -408,7 +417,8 @@ pub fn identify(
             })));
         }
         let res = driver.run()?;
-        if widenings == crate::fit::MAX_WIDENINGS
+        if !cfg.widen_ranges
+            || widenings == crate::fit::MAX_WIDENINGS
             || spec.widen_at_bounds(&res.best_x[..n]).is_empty()
         {
             break res;
