@@ -714,11 +714,16 @@ fn speed_drift_row(
         g >= -n
     };
     // Two held-out views, as for a torque: the validate runs' E_θ, or their own accelerometer
-    // (each run's crank track drifting as the identify runs' do) while E_θ does not rise beyond
-    // its noise. A small drift barely moves the pendulum: a 3.4e-4 Hz/s drift, tracked within
-    // 0.01 %, was refused on an E_θ fall of 37.5 % ± 51.9 %.
+    // (each run's crank track drifting as the identify runs' do) while E_θ falls at all. A
+    // small drift barely moves the pendulum: a 3.4e-4 Hz/s drift, tracked within 0.01 %, was
+    // refused on an E_θ fall of 37.5 % ± 51.9 %. But a drift the tracks confirm and the
+    // pendulum's predictions do not feel is a fact about the motor, not a cause of what the
+    // model gets wrong: another simulator's crank, 3 ppm slower at the end of a run than at
+    // its start (−1.1e-7 Hz/s on a campaign hiding nothing), was named on the tracks' 90 % while
+    // E_θ moved −0.2 % ± 0.2 % (three of `i01_none_quadratic`'s identify runs and two of its
+    // validate runs).
     let (sensor_gain, _, _) = sensor_heldout(&ev.val, 0.0, est);
-    let held_out = gain > gain_needed || (sensor_gain > SENSOR_HELDOUT_GAIN && gain > -noise);
+    let held_out = gain > gain_needed || (sensor_gain > SENSOR_HELDOUT_GAIN && gain > 0.0);
     row.accepted = held_out && views_agree(est, half, refit_est, screen_fits);
     row.heldout_gain = gain;
     row.heldout_noise = noise;
