@@ -275,14 +275,14 @@ impl ModelSpec {
             .unwrap_or_else(|| p.bounds())
     }
 
-    /// Widens the search range of each parameter whose value in `x` (one per [`Self::params`])
-    /// sits at an end of it that is a search convenience, not physics, by doubling the span on
-    /// that side; returns the names widened. A catalogue range is the search's: the data may
-    /// put a bearing's μ at 0.3 or a rotor's J at 0.03 kg·m² (the study's μ < 0.25, and twice a
-    /// survey's sizes, pinned both and neither was named). Only an end at 0 of a range that
-    /// starts there is physical (a loss, a torque's size, an inertia cannot be negative), and it
-    /// stays. The SI catalogue parameters only: ω0 and a free decay's ratios keep their
-    /// data-derived bounds, and an integer is never fitted.
+    /// Widens the search range of each parameter whose value in `x` (one per [`Self::params`]) sits
+    /// at an end of it that is a search convenience, not physics, by doubling the span on that
+    /// side; returns the names widened. A catalogue range is the search's: the data may put a
+    /// bearing's μ at 0.35 (the study's μ < 0.25 pinned a drawn campaign's at 0.24999) or b at 1.2
+    /// N·s/m (twice the survey's, pinned at the study's 1). Only an end at 0 of a range that starts
+    /// there is physical (a loss, a torque's size, an inertia cannot be negative), and it stays.
+    /// The SI catalogue parameters only: ω0 and a free decay's ratios keep their data-derived
+    /// bounds, and an integer is never fitted.
     pub fn widen_at_bounds(&mut self, x: &[f64]) -> Vec<&'static str> {
         let mut widened = Vec::new();
         for (&p, &v) in self.params.clone().iter().zip(x) {
@@ -307,12 +307,12 @@ impl ModelSpec {
         widened
     }
 
-    /// Widens the search range of `p` (as [`Self::widen_at_bounds`] would, side by side, to at
-    /// most 2^[`MAX_WIDENINGS`] times the catalogue's span) until `v` lies inside it with room to move: a tenth of the
-    /// span below the upper end and above a lower end ≤ 0, a tenth of the end's own value above a
-    /// positive lower end (halving it hardly changes the span). A refit that starts at a value
-    /// the catalogue's range does not hold (the screen's estimate of a large effect) can then
-    /// move. Never further: with a margin of a tenth of the span on the positive end too, a
+    /// Widens the search range of `p` (as [`Self::widen_at_bounds`] would, side by side, to at most
+    /// 2^[`MAX_WIDENINGS`] times the catalogue's span) until `v` lies inside it with room to move:
+    /// a tenth of the span below the upper end and above a lower end ≤ 0, a tenth of the end's own
+    /// value above a positive lower end (halving it hardly changes the span). A refit that starts
+    /// at a value the catalogue's range does not hold (the screen's estimate of a large effect) can
+    /// then move. Never further: with a margin of a tenth of the span on the positive end too, a
     /// stribeck v_s of 0.2 rad/s "needed" its 0.01 floor halved without end, and the refit tried
     /// breakaways fading within 1e-11 rad/s, steps too sharp to integrate (a nothing-hidden
     /// campaign's discover took 280 s instead of 3).
