@@ -88,6 +88,17 @@ pub(crate) fn column_f64(path: &Path, name: &str) -> Vec<f64> {
         .collect()
 }
 
+pub(crate) fn column_i64(path: &Path, name: &str) -> Vec<i64> {
+    use arrow_array::Int64Array;
+    column_arrays(path, name)
+        .iter()
+        .flat_map(|c| {
+            let a = c.as_any().downcast_ref::<Int64Array>().unwrap();
+            a.values().to_vec()
+        })
+        .collect()
+}
+
 pub(crate) fn column_bool(path: &Path, name: &str) -> Vec<bool> {
     use arrow_array::{Array, BooleanArray};
     column_arrays(path, name)
@@ -319,4 +330,23 @@ fn damping_past_the_studys_search_range_is_fitted_not_pinned() {
     );
     assert!((b / 0.5 - 1.0).abs() < 0.10, "b = {b}");
     assert!(a < 0.05, "a = {a}");
+    // Every DE round is in the cost reported: the rounds after a widening run on from the last
+    // one's best, each with a new initial population (1000 generations at most per round).
+    let p = out.join("params.parquet");
+    let (gens, evals, np) = (
+        column_i64(&p, "generations")[0],
+        column_i64(&p, "evaluations")[0],
+        column_i64(&p, "np")[0],
+    );
+    // μ past 0.25 needs a widened range, so at least two rounds ran (each capped at 1000).
+    assert!(gens > 1000, "generations {gens}: one round's only");
+    assert_eq!(evals, np * (gens + 1), "generations {gens}, np {np}");
+    let conv = out.join("convergence.parquet");
+    let g: Vec<i64> = column_str(&conv, "model")
+        .iter()
+        .zip(column_i64(&conv, "generation"))
+        .filter(|(m, _)| *m == "reference")
+        .map(|(_, g)| g)
+        .collect();
+    assert_eq!(g, (0..=gens).collect::<Vec<_>>());
 }

@@ -341,14 +341,21 @@ pub struct FitOutcome {
     pub params: Vec<f64>,
     pub f_obj: f64,
     pub e_theta: f64,
+    /// Generations over every DE round: a fit whose search range was widened runs DE again from
+    /// its best (`FitConfig::widen_ranges`), and each further round's initial population counts
+    /// as one generation, so that `evaluations = np · (generations + 1)` as for one run. The
+    /// generation cap holds per round.
     pub generations: u64,
+    /// Evaluations, abandoned evaluations and wall time, summed over the rounds.
     pub evaluations: u64,
     pub abandoned: u64,
+    /// The last round's.
     pub stop_reason: String,
     pub wall_s: f64,
     pub seed: u64,
     pub np: usize,
-    /// (generation, best, worst, mean).
+    /// (generation, best, worst, mean), one entry per generation of every round in order
+    /// (numbered as in `generations`).
     pub convergence: Vec<(u64, f64, f64, f64)>,
     pub runs: Vec<RunFit>,
     /// Polished parameters and objective, when a polish ran.
@@ -395,6 +402,9 @@ pub fn identify(
     // whose estimates sit inside the catalogue's ranges runs once, as it always did.
     let mut init = None;
     let mut widenings = 0;
+    // The rounds' cost, summed (see `FitOutcome::generations`): (generations, evaluations,
+    // abandoned, wall s, convergence history renumbered to follow on).
+    let mut spent = (0u64, 0u64, 0u64, 0.0f64, Vec::new());
     let res = loop {
         let objective = fit_objective(runs, &spec, cfg);
         let de = DeConfig {
@@ -417,6 +427,18 @@ pub fn identify(
             })));
         }
         let res = driver.run()?;
+        // A round's initial population counts as one more generation, so that the sums keep
+        // evaluations = np · (generations + 1) and one history entry per generation.
+        let first = if spent.4.is_empty() { 0 } else { spent.0 + 1 };
+        spent.4.extend(
+            res.history
+                .iter()
+                .map(|g| (first + g.generation, g.best, g.worst, g.mean)),
+        );
+        spent.0 = first + res.generations;
+        spent.1 += res.evaluations;
+        spent.2 += res.abandoned;
+        spent.3 += res.wall_s;
         if !cfg.widen_ranges
             || widenings == crate::fit::MAX_WIDENINGS
             || spec.widen_at_bounds(&res.best_x[..n]).is_empty()
@@ -463,18 +485,14 @@ pub fn identify(
         params: best_x[..n].to_vec(),
         f_obj: if free { eval.f_obj } else { res.best_cost },
         e_theta: eval.e_theta,
-        generations: res.generations,
-        evaluations: res.evaluations,
-        abandoned: res.abandoned,
+        generations: spent.0,
+        evaluations: spent.1,
+        abandoned: spent.2,
         stop_reason: format!("{:?}", res.stop_reason),
-        wall_s: res.wall_s,
+        wall_s: spent.3,
         seed: cfg.seed,
         np,
-        convergence: res
-            .history
-            .iter()
-            .map(|g| (g.generation, g.best, g.worst, g.mean))
-            .collect(),
+        convergence: spent.4,
         runs: run_fits,
         polished: polished.map(|(x, f, k)| (x[..n].to_vec(), f, k)),
         alignments: Default::default(),
