@@ -77,26 +77,26 @@ fn column_arrays(path: &Path, name: &str) -> Vec<arrow_array::ArrayRef> {
         .collect()
 }
 
-pub(crate) fn column_f64(path: &Path, name: &str) -> Vec<f64> {
-    use arrow_array::Float64Array;
+/// A primitive column's values, every record batch in order.
+fn column_values<T: arrow_array::ArrowPrimitiveType>(path: &Path, name: &str) -> Vec<T::Native> {
     column_arrays(path, name)
         .iter()
         .flat_map(|c| {
-            let a = c.as_any().downcast_ref::<Float64Array>().unwrap();
+            let a = c
+                .as_any()
+                .downcast_ref::<arrow_array::PrimitiveArray<T>>()
+                .unwrap();
             a.values().to_vec()
         })
         .collect()
 }
 
+pub(crate) fn column_f64(path: &Path, name: &str) -> Vec<f64> {
+    column_values::<arrow_array::types::Float64Type>(path, name)
+}
+
 pub(crate) fn column_i64(path: &Path, name: &str) -> Vec<i64> {
-    use arrow_array::Int64Array;
-    column_arrays(path, name)
-        .iter()
-        .flat_map(|c| {
-            let a = c.as_any().downcast_ref::<Int64Array>().unwrap();
-            a.values().to_vec()
-        })
-        .collect()
+    column_values::<arrow_array::types::Int64Type>(path, name)
 }
 
 pub(crate) fn column_bool(path: &Path, name: &str) -> Vec<bool> {
