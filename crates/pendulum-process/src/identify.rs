@@ -378,6 +378,16 @@ impl FitOutcome {
     }
 }
 
+/// What the DE rounds of one fit cost, summed over the rounds ([`FitOutcome`]'s fields).
+#[derive(Default)]
+struct Spent {
+    generations: u64,
+    evaluations: u64,
+    abandoned: u64,
+    wall_s: f64,
+    convergence: Vec<(u64, f64, f64, f64)>,
+}
+
 /// Runs the study's identification on the identify runs.
 pub fn identify(
     runs: &[PreparedRun],
@@ -402,9 +412,8 @@ pub fn identify(
     // whose estimates sit inside the catalogue's ranges runs once, as it always did.
     let mut init = None;
     let mut widenings = 0;
-    // The rounds' cost, summed (see `FitOutcome::generations`): (generations, evaluations,
-    // abandoned, wall s, convergence history renumbered to follow on).
-    let mut spent = (0u64, 0u64, 0u64, 0.0f64, Vec::new());
+    // The rounds' cost, summed (see `FitOutcome::generations`).
+    let mut spent = Spent::default();
     let res = loop {
         let objective = fit_objective(runs, &spec, cfg);
         let de = DeConfig {
@@ -429,16 +438,20 @@ pub fn identify(
         let res = driver.run()?;
         // A round's initial population counts as one more generation, so that the sums keep
         // evaluations = np · (generations + 1) and one history entry per generation.
-        let first = if spent.4.is_empty() { 0 } else { spent.0 + 1 };
-        spent.4.extend(
+        let first = if spent.convergence.is_empty() {
+            0
+        } else {
+            spent.generations + 1
+        };
+        spent.convergence.extend(
             res.history
                 .iter()
                 .map(|g| (first + g.generation, g.best, g.worst, g.mean)),
         );
-        spent.0 = first + res.generations;
-        spent.1 += res.evaluations;
-        spent.2 += res.abandoned;
-        spent.3 += res.wall_s;
+        spent.generations = first + res.generations;
+        spent.evaluations += res.evaluations;
+        spent.abandoned += res.abandoned;
+        spent.wall_s += res.wall_s;
         if !cfg.widen_ranges
             || widenings == crate::fit::MAX_WIDENINGS
             || spec.widen_at_bounds(&res.best_x[..n]).is_empty()
@@ -485,14 +498,14 @@ pub fn identify(
         params: best_x[..n].to_vec(),
         f_obj: if free { eval.f_obj } else { res.best_cost },
         e_theta: eval.e_theta,
-        generations: spent.0,
-        evaluations: spent.1,
-        abandoned: spent.2,
+        generations: spent.generations,
+        evaluations: spent.evaluations,
+        abandoned: spent.abandoned,
         stop_reason: format!("{:?}", res.stop_reason),
-        wall_s: spent.3,
+        wall_s: spent.wall_s,
         seed: cfg.seed,
         np,
-        convergence: spent.4,
+        convergence: spent.convergence,
         runs: run_fits,
         polished: polished.map(|(x, f, k)| (x[..n].to_vec(), f, k)),
         alignments: Default::default(),
