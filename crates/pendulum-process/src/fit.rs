@@ -506,6 +506,12 @@ pub struct PreparedRun {
     /// The time unit of `t`, rad/s: sqrt(g/l) with a shaker, the period-derived ω0 estimate
     /// for a free decay.
     pub omega0_rad_s: f64,
+    /// This run's own encoder zeroing error, rad, on top of the model's offset (0 unless a
+    /// caller has estimated it). The count is zeroed at every power-on to within a few counts
+    /// (rig.md), and a 2-count error is a gravity torque of 3e-3 m g l, as large as a plausible
+    /// dry torque: a caller comparing models on one run's fine torques can hold it as a nuisance
+    /// of the run, as its initial state is.
+    pub zero_rad: f64,
 }
 
 impl PreparedRun {
@@ -979,7 +985,7 @@ impl StudyObjective<'_> {
                 run,
                 g,
                 ic,
-                off,
+                off + run.zero_rad,
                 limit - done,
                 ks[g.run],
             ) {
@@ -1011,7 +1017,12 @@ impl StudyObjective<'_> {
     /// has no samples).
     fn initial_states(&self, ics: &[f64], off: f64, ks: &[f64]) -> Vec<[f64; 2]> {
         (0..self.runs.len())
-            .map(|j| [ics[2 * j] - off, ics[2 * j + 1] / ks[j]])
+            .map(|j| {
+                [
+                    ics[2 * j] - off - self.runs[j].zero_rad,
+                    ics[2 * j + 1] / ks[j],
+                ]
+            })
             .collect()
     }
 
@@ -1049,7 +1060,7 @@ impl StudyObjective<'_> {
                 run,
                 g,
                 ic,
-                off,
+                off + run.zero_rad,
                 f64::INFINITY,
                 ks[g.run],
             ) {
@@ -1114,6 +1125,7 @@ impl StudyObjective<'_> {
             let model = self.model_of(run, &p);
             let k = self.spec.time_scale(run, &p);
             let y = g.y0.unwrap_or([ics[2 * g.run], ics[2 * g.run + 1]]);
+            let off = off + run.zero_rad;
             let segment = seg_no[g.run];
             seg_no[g.run] += 1;
             let rec = &mut out[g.run];

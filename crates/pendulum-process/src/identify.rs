@@ -173,6 +173,7 @@ pub fn prepare_run(
         classify: steady_cfg.classify_options(w0 * period_s),
         free: al.is_free(),
         omega0_rad_s: w0,
+        zero_rad: 0.0,
     })
 }
 
