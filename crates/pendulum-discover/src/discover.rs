@@ -417,6 +417,17 @@ pub fn views_agree(
     (refit - screen).abs() <= band || screen_fits_trajectories
 }
 
+/// `x` inside the bounds the refit keeps its parameters to.
+fn clamped(spec: &ModelSpec, x: &[f64]) -> Vec<f64> {
+    x.iter()
+        .zip(&spec.params)
+        .map(|(v, q)| {
+            let (lo, hi) = spec.range(*q);
+            v.clamp(lo, hi)
+        })
+        .collect()
+}
+
 /// Paired comparison of two parameter vectors of one model on the identify runs' trajectories
 /// (initial states `ics`; each vector clamped to the bounds the refit keeps to): the fractional
 /// fall of E_θ from `x` to `x_alt` over their 0.5 s segments and the noise it must beat
@@ -439,15 +450,7 @@ fn trajectory_substitution(
             runs
         };
         let obj = refit_objective(runs, spec);
-        // Inside the parameters' bounds, as the refit is.
-        let mut full: Vec<f64> = p
-            .iter()
-            .zip(&spec.params)
-            .map(|(v, q)| {
-                let (lo, hi) = spec.range(*q);
-                v.clamp(lo, hi)
-            })
-            .collect();
+        let mut full = clamped(spec, p);
         full.extend_from_slice(ics);
         obj.evaluate(&full).per_run_segment_e.concat()
     };
@@ -1078,37 +1081,14 @@ fn with_run_zeros(
     x: &[f64],
     ics: &[f64],
 ) -> Vec<PreparedRun> {
-    use rayon::prelude::*;
     let bound = pendulum_model::effects::by_name("encoder_offset")
         .and_then(|e| e.tolerance())
         .map_or(0.0, |t| t.bound(0.0, 0.0));
     if bound <= 0.0 || ics.len() != 2 * runs.len() {
         return runs.to_vec();
     }
-    let params: Vec<f64> = x
-        .iter()
-        .zip(&spec.params)
-        .map(|(v, q)| {
-            let (lo, hi) = spec.range(*q);
-            v.clamp(lo, hi)
-        })
-        .collect();
-    let zeros: Vec<f64> = runs
-        .par_iter()
-        .enumerate()
-        .map(|(j, run)| {
-            let mut full = params.clone();
-            full.extend_from_slice(&ics[2 * j..2 * j + 2]);
-            let e_theta = |z: f64| {
-                let one = [PreparedRun {
-                    zero_rad: z,
-                    ..run.clone()
-                }];
-                refit_objective(&one, spec).evaluate(&full).e_theta
-            };
-            pendulum_numerics::golden_section(e_theta, -bound, bound, ZERO_SEARCH_ITERS).x
-        })
-        .collect();
+    let zeros =
+        refit_objective(runs, spec).run_zeros(&clamped(spec, x), ics, bound, ZERO_SEARCH_ITERS);
     let common_offset = spec
         .params
         .iter()
@@ -1598,7 +1578,7 @@ pub fn discover(
         // the refit repeated from there (estimated at the screen's start, where the model may
         // still be far off, they moved refits by more than the error itself). Not for a sensor
         // effect: an offset is the runs' common zeroing error (their own ones took a hidden
-        // 0.022 rad offset's refit 20 % low, so the views disagreed), and an accelerometer lag
+        // 0.022 rad offset's refit 18 % low, so the views disagreed), and an accelerometer lag
         // is estimated on the measured motion; both were named before and were lost with it.
         let run_zeros = matches!(effect.kind(), Kind::Dynamics | Kind::Mass);
         // The current model's local refit is cached per kind of refit (tails, zeros).
