@@ -1379,6 +1379,20 @@ mod tests {
         }
     }
 
+    /// Output error only (no steady-state penalty), tolerance 1e-8, parameters free.
+    fn plain_objective<'a>(runs: &'a [PreparedRun], spec: &'a ModelSpec) -> StudyObjective<'a> {
+        StudyObjective {
+            runs,
+            spec,
+            kappa: 1.0,
+            sim: SimOptions::with_tol(1e-8),
+            ic_halfwidth: 0.1,
+            fixed_params: None,
+            penalty: false,
+            order: WorkOrder::default(),
+        }
+    }
+
     /// A run's own zeroing error is found from its trajectory: the same simulated run read
     /// 2 counts high (every sample and restart state shifted) is given back its 2 counts, and the
     /// unshifted one 0, each to a tenth of a count; the model's own offset is not counted twice.
@@ -1399,16 +1413,7 @@ mod tests {
             .iter()
             .flat_map(|r| [r.ic_est[0] + (r.theta[0] - plain.theta[0]), r.ic_est[1]])
             .collect();
-        let objective = StudyObjective {
-            runs: &runs,
-            spec: &spec,
-            kappa: 1.0,
-            sim: SimOptions::with_tol(1e-8),
-            ic_halfwidth: 0.1,
-            fixed_params: None,
-            penalty: false,
-            order: WorkOrder::default(),
-        };
+        let objective = plain_objective(&runs, &spec);
         let zeros = objective.run_zeros(&p, &ics, 4.0 * count, 40);
         assert!(zeros[0].abs() < 0.1 * count, "{}", zeros[0] / count);
         assert!(
@@ -1548,16 +1553,7 @@ mod tests {
     fn misfit_ratio_tells_a_following_model_from_standing_still() {
         let r = run(1.75, STUDY, [1.0, -1.5]);
         let spec = ModelSpec::reference();
-        let objective = StudyObjective {
-            runs: std::slice::from_ref(&r),
-            spec: &spec,
-            kappa: 1.0,
-            sim: SimOptions::with_tol(1e-8),
-            ic_halfwidth: 0.1,
-            fixed_params: None,
-            penalty: false,
-            order: WorkOrder::default(),
-        };
+        let objective = plain_objective(std::slice::from_ref(&r), &spec);
         let mut x = STUDY.to_vec();
         x.extend_from_slice(&r.ic_est);
         let e = objective.evaluate(&x).per_run_e[0];
