@@ -1155,13 +1155,12 @@ impl StudyObjective<'_> {
         }
         out
     }
-}
 
-impl StudyObjective<'_> {
-    /// Each run's own encoder zeroing error ([`PreparedRun::zero_rad`]) under the parameters
-    /// `p` and initial states `ics` (two per run): the value within ±`bound_rad` that minimises
-    /// that run's E_θ alone (golden section, `iters` shrinks), each run on its own, its initial
-    /// state held. The runs' own `zero_rad` are ignored (replaced, not added to).
+    /// Each run's own encoder zeroing error ([`PreparedRun::zero_rad`]) under the damping
+    /// parameters `p` and initial states `ics` (two per run): the value within ±`bound_rad` that
+    /// minimises that run's E_θ alone (golden section, `iters` shrinks), each run on its own, its
+    /// initial state held. The runs' own `zero_rad` are replaced, not added to; the objective's
+    /// settings are used but not its `fixed_params` (`p` are the parameters).
     pub fn run_zeros(&self, p: &[f64], ics: &[f64], bound_rad: f64, iters: usize) -> Vec<f64> {
         use rayon::prelude::*;
         self.runs
