@@ -32,6 +32,13 @@ fn discover_in(
 ) -> DiscoverSummary {
     let camp = dir.join("campaign");
     make_campaign(&camp, &campaign(seed, a, b, mu, effects));
+    // Kept before the run, so a case that is slow or fails can be run again alone.
+    if let Ok(keep) = std::env::var("SURVEY_KEEP") {
+        let to = Path::new(&keep);
+        std::fs::create_dir_all(to).unwrap();
+        std::fs::write(to.join("case.toml"), campaign(seed, a, b, mu, effects)).unwrap();
+        eprintln!("kept the twin case in {}", to.display());
+    }
     let s = run(&DiscoverJob {
         input: camp,
         out: dir.join("out"),
@@ -43,12 +50,6 @@ fn discover_in(
     })
     .unwrap();
     eprintln!("{s}");
-    if let Ok(keep) = std::env::var("SURVEY_KEEP") {
-        let to = Path::new(&keep);
-        std::fs::create_dir_all(to).unwrap();
-        std::fs::write(to.join("case.toml"), campaign(seed, a, b, mu, effects)).unwrap();
-        eprintln!("kept the twin case in {}", to.display());
-    }
     for f in [
         "diagnosis.parquet",
         "signatures.parquet",

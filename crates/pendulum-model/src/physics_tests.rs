@@ -629,3 +629,44 @@ fn generator_grazing_its_band_edge_is_no_zeno_loop() {
     .unwrap();
     assert!(stats.band_events > 100 && stats.steps < 20_000, "{stats:?}");
 }
+
+/// A bob at rest just outside the friction cone (tan θ = 1.008 μ) with the bearing load following
+/// the base, while the crank's vertical acceleration passes through g (R = 1.39): with no
+/// horizontal forcing |Q|/C = |tan θ|/μ whatever the forcing, so the bob slips slowly through
+/// that passage. A step that breaks loose from rest and runs past the slip's return to rest must
+/// be shortened, not taken as an event at its start: that mistake made an event per 1e-9·t of
+/// time, 687 728 in this 3-unit segment (taken, state and samples as they were, from a discover
+/// run's validation at its tolerance, 1e-6, where it cost 20 minutes). The end state is held to
+/// the same integration at a 10⁴ times tighter tolerance, within a few times the tolerance.
+#[test]
+fn slip_from_rest_outlasting_a_step_is_no_zeno_loop() {
+    let mut d = Dimensionless::conservative();
+    (d.omega, d.r, d.lambda) = (1.757094672723873, 1.3850301173942983, 0.18521739130434783);
+    (d.beta, d.m_coulomb, d.base_load) = (0.05348502616317227, 0.01141098273443439, true);
+    let m = Model::new(d).with_crank_table();
+    let (t0, t1) = (22.50195521270339, 25.651788493944434);
+    // The segment's 50 samples.
+    let times: Vec<f64> = (0..50).map(|i| t0 + (t1 - t0) * i as f64 / 49.0).collect();
+    let y0 = [0.011504855909142363, -1.5692335736255763e-16];
+    let run = |tol: f64| {
+        let mut end = [0.0; 2];
+        let opts = SimOptions {
+            h_init: Some(0.1),
+            max_steps: 100_000,
+            ..SimOptions::with_tol(tol)
+        };
+        let stats = integrate(&m, &opts, t0, y0, t1, times.iter().copied(), |s| {
+            end = [s.theta, s.theta_dot];
+            ControlFlow::Continue(())
+        })
+        .unwrap();
+        (end, stats)
+    };
+    let (end, stats) = run(1e-6);
+    let (tight, _) = run(1e-10);
+    assert!(stats.events < 100, "{stats:?}");
+    assert!(
+        (end[0] - tight[0]).abs() < 5e-6 && (end[1] - tight[1]).abs() < 5e-6,
+        "{end:?} against {tight:?}"
+    );
+}
