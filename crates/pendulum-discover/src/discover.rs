@@ -428,37 +428,47 @@ fn clamped(spec: &ModelSpec, x: &[f64]) -> Vec<f64> {
         .collect()
 }
 
-/// Paired comparison of two parameter vectors of one model on the identify runs' trajectories
-/// (initial states `ics`; each vector clamped to the bounds the refit keeps to): the fractional
-/// fall of E_θ from `x` to `x_alt` over their 0.5 s segments and the noise it must beat
-/// (negative: `x_alt` is worse). With `run_zeros`, each vector is judged with the runs' own
-/// zeroing errors estimated under it ([`with_run_zeros`]): a nuisance refitted for every model.
+/// The identify runs' E_θ per 0.5 s segment under parameters `p` of `spec` (initial states
+/// `ics`; `p` clamped to the bounds the refit keeps to): one side of a
+/// [`trajectory_substitution`]. With `run_zeros`, the runs' own zeroing errors are estimated
+/// under `p` ([`with_run_zeros`]): a nuisance refitted for every model.
+fn substitution_segments(
+    runs: &[PreparedRun],
+    spec: &ModelSpec,
+    p: &[f64],
+    ics: &[f64],
+    run_zeros: bool,
+) -> Vec<f64> {
+    let zeroed;
+    let runs = if run_zeros {
+        zeroed = with_run_zeros(runs, spec, p, ics);
+        &zeroed[..]
+    } else {
+        runs
+    };
+    let obj = refit_objective(runs, spec);
+    let mut full = clamped(spec, p);
+    full.extend_from_slice(ics);
+    obj.evaluate(&full).per_run_segment_e.concat()
+}
+
+/// Paired comparison of two parameter vectors of one model on the identify runs' trajectories:
+/// the fractional fall of E_θ from the first (its [`substitution_segments`], `a`, computed once
+/// for the several alternatives it is compared with) to `x_alt` over their 0.5 s segments and
+/// the noise it must beat (negative: `x_alt` is worse).
 fn trajectory_substitution(
     runs: &[PreparedRun],
     spec: &ModelSpec,
-    x: &[f64],
+    a: &[f64],
     x_alt: &[f64],
     ics: &[f64],
     run_zeros: bool,
 ) -> (f64, f64) {
-    let segments = |p: &[f64]| -> Vec<f64> {
-        let zeroed;
-        let runs = if run_zeros {
-            zeroed = with_run_zeros(runs, spec, p, ics);
-            &zeroed[..]
-        } else {
-            runs
-        };
-        let obj = refit_objective(runs, spec);
-        let mut full = clamped(spec, p);
-        full.extend_from_slice(ics);
-        obj.evaluate(&full).per_run_segment_e.concat()
-    };
-    let (a, b) = (segments(x), segments(x_alt));
+    let b = substitution_segments(runs, spec, x_alt, ics, run_zeros);
     if a.len() != b.len() {
         return (f64::NEG_INFINITY, 0.0);
     }
-    paired_gain(&a, &b)
+    paired_gain(a, &b)
 }
 
 /// An accelerometer sensitivity error under 1 % is within a calibrated MPU-6050's tolerance and
@@ -719,10 +729,11 @@ fn speed_drift_row(
     row.refit_estimate = refit_est;
     // The track's value is inside the trajectories' interval when the profile through it (the
     // damping refitted with the drift held there) is not significantly worse than the refit.
+    let seg_x = substitution_segments(&traj2, &spec, &x, &traj_ics2, false);
     let screen_fits = {
         let i = spec.params.len() - 1;
         let x_prof = refit_profile(&traj2, &spec, &x0, &traj_ics2, cfg.refit_evals, i);
-        let (g, n) = trajectory_substitution(&traj2, &spec, &x, &x_prof, &traj_ics2, false);
+        let (g, n) = trajectory_substitution(&traj2, &spec, &seg_x, &x_prof, &traj_ics2, false);
         g >= -n
     };
     // Two held-out views, as for a torque: the validate runs' E_θ, or their own accelerometer
@@ -750,7 +761,7 @@ fn speed_drift_row(
         let mut start = x.clone();
         start[i] = 0.0;
         let x_zero = refit_profile(&traj2, &spec, &start, &traj_ics2, cfg.refit_evals, i);
-        let (g0, n0) = trajectory_substitution(&traj2, &spec, &x, &x_zero, &traj_ics2, false);
+        let (g0, n0) = trajectory_substitution(&traj2, &spec, &seg_x, &x_zero, &traj_ics2, false);
         without = Some((g0, n0));
         g0 < -n0
     };
@@ -1656,8 +1667,9 @@ pub fn discover(
                 }
                 None => x0.clone(),
             };
+            let seg_x = substitution_segments(&traj_runs, &spec, &x, &traj_ics, run_zeros);
             let (g, n) =
-                trajectory_substitution(&traj_runs, &spec, &x, &x_prof, &traj_ics, run_zeros);
+                trajectory_substitution(&traj_runs, &spec, &seg_x, &x_prof, &traj_ics, run_zeros);
             // "Not significantly worse" confirms the screen's value only where the trajectories
             // can tell the effect from its absence at all: through chaos they often cannot, and
             // a 0.020 kg·m² "extra inertia" (the refit: 0.00045) that stood in for a
@@ -1668,7 +1680,7 @@ pub fn discover(
                     let mut x_zero = x.clone();
                     x_zero[i] = 0.0;
                     let (g0, n0) = trajectory_substitution(
-                        &traj_runs, &spec, &x, &x_zero, &traj_ics, run_zeros,
+                        &traj_runs, &spec, &seg_x, &x_zero, &traj_ics, run_zeros,
                     );
                     g0 < -n0
                 }
