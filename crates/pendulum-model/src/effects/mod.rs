@@ -427,6 +427,13 @@ pub trait Effect: Sync + std::fmt::Debug {
         None
     }
 
+    /// The catalogue effect this one becomes in a limit of its extra parameters (stribeck, as
+    /// v_s grows past the swings' speeds: a constant dry torque, coulomb_constant). Where the
+    /// two describe the data about equally well, the simpler one is the finding.
+    fn generalises(&self) -> Option<&'static str> {
+        None
+    }
+
     /// The start of its refit from the screen, in [`Effect::params`]' order: given the size
     /// (already inside its range), its group's coefficients and the group. Default: the size,
     /// then each further parameter's `unset` value.

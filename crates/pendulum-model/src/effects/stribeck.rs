@@ -50,6 +50,9 @@ impl Effect for Stribeck {
     fn sets_sticking_capacity(&self) -> bool {
         true
     }
+    fn generalises(&self) -> Option<&'static str> {
+        Some("coulomb_constant")
+    }
     fn name(&self) -> &'static str {
         "stribeck"
     }
