@@ -1902,11 +1902,7 @@ pub fn discover(
                 format!("k = {}; screened out", sc.candidate.k)
             } else if sc.candidate.add.iter().all(|c| screened.nuisance.contains(c)) {
                 "within the rig's zeroing tolerance (under 4 counts): kept as a nuisance term, not named".into()
-            } else if let Some(simpler) = pendulum_model::effects::by_name(&sc.candidate.effect)
-                .and_then(|e| e.generalises())
-                .and_then(|name| first_round.iter().find(|r| r.candidate.effect == name))
-                .filter(|r| r.delta_bic - sc.delta_bic < crate::screen::GENERALISATION_BIC)
-            {
+            } else if let Some(simpler) = crate::screen::yields_to(first_round, sc) {
                 format!(
                     "not told from {} (ΔBIC {:.1} against its {:.1}; the more general one goes first only {:.0} lower): the simpler one was screened instead",
                     simpler.candidate.effect,

@@ -502,18 +502,21 @@ pub fn is_nuisance(s: &Screened) -> bool {
 /// named, 2.4 below the constant dry torque actually hidden, on a held-out fall of 6.1 % ± 3.7 %.
 pub const GENERALISATION_BIC: f64 = 6.0;
 
-/// The round's best candidate, unless it generalises another ranked candidate that comes within
-/// [`GENERALISATION_BIC`] of it: then that simpler one (which must pass the screen's threshold
-/// on its own; the more general one can still enter a later round, given the simpler one).
+/// The simpler candidate of `ranked` that `c` generalises, when it comes within
+/// [`GENERALISATION_BIC`] of `c`'s ΔBIC: the one the screen takes instead of `c`.
+pub fn yields_to<'a>(ranked: &'a [Screened], c: &Screened) -> Option<&'a Screened> {
+    pendulum_model::effects::by_name(&c.candidate.effect)
+        .and_then(|e| e.generalises())
+        .and_then(|name| ranked.iter().find(|r| r.candidate.effect == name))
+        .filter(|r| r.delta_bic - c.delta_bic < GENERALISATION_BIC)
+}
+
+/// The round's best candidate, or the simpler one it [`yields_to`] (which must pass the
+/// screen's threshold on its own; the more general one can still enter a later round, given
+/// the simpler one).
 fn parsimonious(ranked: &[Screened]) -> Option<&Screened> {
     let best = ranked.first()?;
-    let simpler = pendulum_model::effects::by_name(&best.candidate.effect)
-        .and_then(|e| e.generalises())
-        .and_then(|name| ranked.iter().find(|r| r.candidate.effect == name));
-    match simpler {
-        Some(s) if s.delta_bic - best.delta_bic < GENERALISATION_BIC => Some(s),
-        _ => Some(best),
-    }
+    Some(yields_to(ranked, best).unwrap_or(best))
 }
 
 /// Result of the forward stepwise screen.
