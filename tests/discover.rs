@@ -648,7 +648,7 @@ fn a_run_zeroed_off_by_counts_does_not_hide_a_cogging_torque() {
 /// scale its profile put at 1.2 rad/s (a dry torque that fades only at the fastest swings), ΔBIC
 /// −13.9: that breakaway was named on a held-out fall of 6.1 % ± 3.7 %. The more general effect
 /// goes first only on strong evidence (ΔBIC 6 lower), so the constant one is screened, and it is
-/// the one named (at −14 %: on this draw its refit is the screen's other view), not the
+/// the one named (at −14 %, so the survey counts it named but not within 10 %), not the
 /// breakaway; the breakaway's row says why it was not tried.
 #[test]
 fn a_constant_dry_torque_is_not_named_as_a_breakaway_it_equals() {
