@@ -347,3 +347,166 @@ fn departures_outside_their_range_are_refused_by_key() {
         );
     }
 }
+
+/// A departure drawn for [`survey_departures_name_nothing`]: the table's draw of it.
+type DrawDeparture = fn(&mut rand_chacha::ChaCha8Rng) -> String;
+
+/// The survey's departures, each with how its size is drawn: wider than the regression tests
+/// above (springs from barely felt to stiff, encoders mislabelled on either side of their
+/// header, plays, growths and run spreads from small to large).
+const DEPARTURES: [(&str, DrawDeparture); 6] = [
+    ("torsion_spring", |r| {
+        let k = (r.random_range(0.02f64.ln()..0.3f64.ln())).exp();
+        format!("torsion_spring_nm_per_rad = {k}")
+    }),
+    ("slack_cable", |r| {
+        let k = r.random_range(0.05..0.3);
+        let slack = r.random_range(0.2..1.0);
+        format!("torsion_spring_nm_per_rad = {k}\ncable_slack_rad = {slack}")
+    }),
+    ("encoder_cpr", |r| {
+        // 2–8 % off its header, either side.
+        let off = r.random_range(0.02..0.08) * if r.random_bool(0.5) { 1.0 } else { -1.0 };
+        format!("encoder_cpr_true = {}", 4096.0 * (1.0 + off))
+    }),
+    ("dry_torque_growth", |r| {
+        let rate = (r.random_range(1e-4f64.ln()..6e-4f64.ln())).exp();
+        format!("dry_torque_growth_nm_per_s = {rate}")
+    }),
+    ("encoder_backlash", |r| {
+        format!("encoder_backlash_rad = {}", r.random_range(0.004..0.04))
+    }),
+    ("mu_run_spread", |r| {
+        format!("mu_run_spread = {}", r.random_range(0.1..0.4))
+    }),
+];
+
+/// The survey's campaign `k` of departure `name`: (campaign seed, b, μ, the departure's lines).
+fn drawn_departure(name: &str, k: u64) -> (u64, f64, f64, String) {
+    let d_idx = DEPARTURES.iter().position(|(n, _)| *n == name).unwrap();
+    let mut r = rng(100 + d_idx as u64);
+    let mut out = None;
+    for _ in 0..=k {
+        let departure = (DEPARTURES[d_idx].1)(&mut r);
+        let (b, mu) = (r.random_range(0.3..0.7), r.random_range(0.08..0.2));
+        out = Some((b, mu, departure));
+    }
+    let (b, mu, departure) = out.unwrap();
+    (9000 + 100 * d_idx as u64 + k, b, mu, departure)
+}
+
+/// Survey (slow, by hand with `--ignored`): every twin departure outside the catalogue over
+/// `DEPARTURE_N` drawn campaigns each (default 3), at sizes drawn as [`DEPARTURES`] says,
+/// damping drawn as the false-alarm survey draws it. Prints what each names and says; asserts
+/// that none names a catalogue effect (effects.md: the nearest catalogue entry is not the
+/// cause). `DEPARTURE_ONE=name:k` re-runs one (`KEEP_DEP=PREFIX` keeps its case).
+#[test]
+#[ignore = "survey for issue 14 item 3: 6 departures × DEPARTURE_N (default 3) drawn campaigns; ~2 minutes on 2 cores"]
+fn survey_departures_name_nothing() {
+    let n: u64 = std::env::var("DEPARTURE_N")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(3);
+    let one = std::env::var("DEPARTURE_ONE").ok();
+    let (mut named, mut said, mut total) = (0, 0, 0);
+    let mut wrong = Vec::new();
+    for (name, _) in DEPARTURES {
+        for k in 0..n {
+            if one.as_deref().is_some_and(|o| o != format!("{name}:{k}")) {
+                continue;
+            }
+            let (seed, b, mu, departure) = drawn_departure(name, k);
+            let s = discover_with(seed, b, mu, &departure);
+            let d = &s.discovery;
+            total += 1;
+            named += usize::from(!d.accepted().is_empty());
+            said += usize::from(d.unexplained.is_some());
+            let line = format!(
+                "survey-departure {name} k={k} ({}) b={b:.3} mu={mu:.3} accepted={:?} variable={:?} unexplained={:?}",
+                departure.replace('\n', ", "),
+                d.accepted(),
+                d.unexplained_description.as_ref().map(|x| x.variable),
+                d.unexplained
+            );
+            eprintln!("{line}");
+            if !d.accepted().is_empty() {
+                wrong.push(line);
+            }
+        }
+    }
+    eprintln!(
+        "survey-departure: a catalogue effect named in {named} of {total}; `unexplained` said in {said} of {total}"
+    );
+    assert!(wrong.is_empty(), "{wrong:#?}");
+}
+
+/// A torsion spring too weak to tell from a `position_torque` k = 1 by the share it leaves
+/// (0.028 N·m/rad, the departure survey's draw 2): sin θ and cos θ took ΔBIC −414 of it and the
+/// one term θ did 75 better (a share of 0.85, above the partial rule's 0.75). It was named, and
+/// a k = 2 position torque beside it. A shape no freer than the candidate's that fits clearly
+/// better makes the candidate the wrong shape: `unexplained`, following the unwrapped θ, a
+/// spring, its k within 10 %.
+#[test]
+fn a_weak_torsion_spring_is_not_named_a_position_torque() {
+    let (seed, b, mu, departure) = drawn_departure("torsion_spring", 2);
+    let k: f64 = departure.rsplit(' ').next().unwrap().parse().unwrap();
+    let s = discover_with(seed, b, mu, &departure);
+    let d = &s.discovery;
+    assert!(d.accepted().is_empty(), "named {:?}", d.accepted());
+    let desc = d.unexplained_description.as_ref().expect("a description");
+    assert_eq!(desc.variable, Variable::Angle, "{desc:?}");
+    let theta = desc
+        .terms
+        .iter()
+        .find(|(j, _, _)| LIBRARY[*j].name == "θ")
+        .unwrap_or_else(|| panic!("no linear θ term in {desc:?}"));
+    assert!(
+        (theta.1 - k).abs() < 0.1 * k,
+        "spring {k:.4e} described as {:.4e}",
+        theta.1
+    );
+}
+
+/// A dry torque growing fast (4.5e-4 N·m/s, the departure survey's draw 0) fitted well enough
+/// as a constant one that both views agreed on it: `coulomb_constant` was named. Its size
+/// following time is a freer shape of the same torque (t sgn θ̇ beside sgn θ̇), which no
+/// catalogue entry of one fixed size is: `unexplained`, following time, growing, the rate
+/// within 25 %.
+#[test]
+fn a_fast_growing_dry_torque_is_not_named_a_constant_one() {
+    let (seed, b, mu, departure) = drawn_departure("dry_torque_growth", 0);
+    let rate: f64 = departure.rsplit(' ').next().unwrap().parse().unwrap();
+    let s = discover_with(seed, b, mu, &departure);
+    let d = &s.discovery;
+    assert!(d.accepted().is_empty(), "named {:?}", d.accepted());
+    let desc = d.unexplained_description.as_ref().expect("a description");
+    assert_eq!(desc.variable, Variable::Time, "{desc:?}");
+    let growth = desc
+        .terms
+        .iter()
+        .find(|(j, _, _)| LIBRARY[*j].name == "t sgn θ̇")
+        .unwrap_or_else(|| panic!("no t sgn θ̇ term in {desc:?}"));
+    assert!(
+        (growth.1 - rate).abs() < 0.25 * rate,
+        "growth {rate:.4e} described as {:.4e}",
+        growth.1
+    );
+    assert!(d
+        .unexplained
+        .as_deref()
+        .unwrap_or_default()
+        .contains("growing with time"));
+}
+
+/// A 0.029 rad encoder backlash (the departure survey's draw 0) was named a −0.74 ms
+/// accelerometer "delay": a lead, which no filter or read latency makes. Refused as physically
+/// impossible, and said.
+#[test]
+fn an_encoder_backlash_is_not_named_an_accelerometer_lead() {
+    let (seed, b, mu, departure) = drawn_departure("encoder_backlash", 0);
+    let s = discover_with(seed, b, mu, &departure);
+    let d = &s.discovery;
+    assert!(d.accepted().is_empty(), "named {:?}", d.accepted());
+    let words = d.unexplained.as_deref().expect("`unexplained` said");
+    assert!(words.contains("physically impossible"), "{words}");
+}

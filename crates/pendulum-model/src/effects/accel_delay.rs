@@ -30,6 +30,13 @@ impl Effect for AccelDelay {
     fn tolerance(&self) -> Option<Tolerance> {
         Some(Tolerance::StampJitter(2.0))
     }
+    /// A lag, never a lead: a filter and a read latency both make the samples see the motion
+    /// after it happens (effects.md: "lag the true motion by Δ"). A lead beyond the stamps'
+    /// jitter is a departure the delay does not describe: a 0.029 rad encoder backlash, whose
+    /// measured angle lags the shaft at every turn-around, was named a −0.74 ms "delay".
+    fn possible(&self, size: f64) -> bool {
+        size >= 0.0
+    }
     fn regressors(&self) -> &'static [Regressor] {
         &REGRESSORS
     }
@@ -50,5 +57,19 @@ impl Effect for AccelDelay {
     }
     fn sense(&self, v: &[f64], s: &mut Sensors) {
         s.accel_delay_s = v[0];
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::Effect;
+
+    /// A lag is physically possible and a lead is not, however small: the tolerance for the
+    /// stamps' jitter is discover's to apply, not the range's.
+    #[test]
+    fn a_lag_is_possible_and_a_lead_is_not() {
+        let e = super::AccelDelay;
+        assert!(e.possible(0.005) && e.possible(0.0));
+        assert!(!e.possible(-1e-6) && !e.possible(-0.00074));
     }
 }
