@@ -329,6 +329,11 @@ fn departures_outside_their_range_are_refused_by_key() {
             "cable_slack_rad",
         ),
         ("cable_slack_rad = 0.5", "cable_slack_rad"),
+        ("cable_anchor_rad = 0.3", "cable_anchor_rad"),
+        (
+            "torsion_spring_nm_per_rad = 0.1\ncable_anchor_rad = 4.0",
+            "cable_anchor_rad",
+        ),
     ] {
         let toml = pendulum_jobs::demo::discovery_campaign(
             "departure",
@@ -354,7 +359,7 @@ type DrawDeparture = fn(&mut rand_chacha::ChaCha8Rng) -> String;
 /// The survey's departures, each with how its size is drawn: wider than the regression tests
 /// above (springs from barely felt to stiff, encoders mislabelled on either side of their
 /// header, plays, growths and run spreads from small to large).
-const DEPARTURES: [(&str, DrawDeparture); 6] = [
+const DEPARTURES: [(&str, DrawDeparture); 7] = [
     ("torsion_spring", |r| {
         let k = (r.random_range(0.02f64.ln()..0.3f64.ln())).exp();
         format!("torsion_spring_nm_per_rad = {k}")
@@ -379,6 +384,12 @@ const DEPARTURES: [(&str, DrawDeparture); 6] = [
     ("mu_run_spread", |r| {
         format!("mu_run_spread = {}", r.random_range(0.1..0.4))
     }),
+    ("anchored_cable", |r| {
+        // A cable anchored to one side: a spring plus a constant torque k·anchor.
+        let k = (r.random_range(0.03f64.ln()..0.3f64.ln())).exp();
+        let anchor = r.random_range(0.1..0.6) * if r.random_bool(0.5) { 1.0 } else { -1.0 };
+        format!("torsion_spring_nm_per_rad = {k}\ncable_anchor_rad = {anchor}")
+    }),
 ];
 
 /// The survey's campaign `k` of departure `name`: (campaign seed, b, μ, the departure's lines).
@@ -401,7 +412,7 @@ fn drawn_departure(name: &str, k: u64) -> (u64, f64, f64, String) {
 /// that none names a catalogue effect (effects.md: the nearest catalogue entry is not the
 /// cause). `DEPARTURE_ONE=name:k` re-runs one (`KEEP_DEP=PREFIX` keeps its case).
 #[test]
-#[ignore = "survey for issue 14 item 3: 6 departures × DEPARTURE_N (default 3) drawn campaigns; ~2 minutes on 2 cores"]
+#[ignore = "survey for issue 14 item 3: 7 departures × DEPARTURE_N (default 3) drawn campaigns; ~3 minutes on 2 cores"]
 fn survey_departures_name_nothing() {
     let n: u64 = std::env::var("DEPARTURE_N")
         .ok()

@@ -227,6 +227,11 @@ pub struct Dimensionless {
     /// honest `unexplained`). Absent = 0: the spring acts everywhere.
     #[serde(default)]
     pub kappa_slack: f64,
+    /// Where the spring is unstretched, rad: a cable anchored off the hanging position pulls
+    /// as −κ(θ − anchor) (a spring plus a constant torque; a departure outside the catalogue
+    /// for tests of an honest `unexplained`). Absent = 0.
+    #[serde(default)]
+    pub kappa_anchor: f64,
     /// Growth rate of the constant dry torque, dc/dt per dimensionless time (c + c_rate·t, t
     /// from the simulation's start): a bearing whose drag grows as it runs (heating, a seal
     /// drying out), a departure outside the catalogue for tests of an honest `unexplained`.
@@ -254,11 +259,12 @@ pub struct Slot {
 }
 
 impl Dimensionless {
-    /// The spring's stretch at θ: θ itself, or beyond a slack of ±`kappa_slack` what lies past
-    /// it (torque −κ·stretch, energy κ·stretch²/2).
+    /// The spring's stretch at θ: θ − `kappa_anchor` itself, or beyond a slack of
+    /// ±`kappa_slack` what lies past it (torque −κ·stretch, energy κ·stretch²/2).
     #[inline]
     pub fn spring_stretch(&self, theta: f64) -> f64 {
-        theta - theta.clamp(-self.kappa_slack, self.kappa_slack)
+        let x = theta - self.kappa_anchor;
+        x - x.clamp(-self.kappa_slack, self.kappa_slack)
     }
 
     /// A free pendulum with no damping and no base motion.
@@ -284,6 +290,7 @@ impl Dimensionless {
             gen_w: 0.0,
             kappa: 0.0,
             kappa_slack: 0.0,
+            kappa_anchor: 0.0,
             c_rate: 0.0,
         }
     }
@@ -413,6 +420,7 @@ impl Dimensionless {
                 false,
                 Some((self.kappa_slack >= 0.0, NON_NEG)),
             ),
+            slot("kappa_anchor", "θ_anchor", self.kappa_anchor, false, None),
             slot("tan_delta", "tan δ", self.tan_delta, false, None),
             slot("j", "j", self.j, false, Some((self.j > -1.0, "j > −1"))),
             slot("omega_drift", "dω/dt", self.omega_drift, false, None),

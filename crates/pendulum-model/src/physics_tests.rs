@@ -93,6 +93,39 @@ fn energy_conserved_with_a_slack_cable() {
     assert!(gap > 0.1, "slack and taut swings differ by {gap} rad only");
 }
 
+/// A cable spring anchored off the hanging position (κ = 0.5, unstretched at 0.4 rad) is
+/// conservative with its potential κ(θ − anchor)²/2, and it moves the rest: the static balance
+/// sin θ = κ(anchor − θ) holds where a heavily damped swing settles.
+#[test]
+fn an_anchored_cable_conserves_energy_and_moves_the_rest() {
+    let mut d = Dimensionless::conservative();
+    d.kappa = 0.5;
+    d.kappa_anchor = 0.4;
+    let m = Model::with_excitation(d, Excitation::None);
+    let opts = SimOptions::with_tol(1e-12);
+    let tr = simulate(&m, &opts, [1.2, 0.0], 0.0, 300.0, 0.05).unwrap();
+    let worst = energy_drift(&m, &tr, m.energy(1.2, 0.0));
+    assert!(worst < 1e-8, "energy drift {worst}");
+    let mut damped = d;
+    damped.beta = 0.5;
+    let tr = simulate(
+        &Model::with_excitation(damped, Excitation::None),
+        &opts,
+        [1.2, 0.0],
+        0.0,
+        200.0,
+        0.05,
+    )
+    .unwrap();
+    let rest = *tr.theta.last().unwrap();
+    // Newton on sin θ − κ(anchor − θ) = 0.
+    let mut th: f64 = 0.1;
+    for _ in 0..50 {
+        th -= (th.sin() - 0.5 * (0.4 - th)) / (th.cos() + 0.5);
+    }
+    assert!((rest - th).abs() < 1e-6, "rests at {rest}, balance at {th}");
+}
+
 /// Constant dry torque c: from rest at −A the pendulum next rests at B with
 /// −cos B + cos A = −c (A + B) (the work of friction), exactly, for any amplitude.
 #[test]

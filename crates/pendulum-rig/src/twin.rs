@@ -86,6 +86,11 @@ pub struct Departures {
     /// pulls only beyond it (a dead band in the unwrapped θ; with `torsion_spring_nm_per_rad`).
     #[serde(default)]
     pub cable_slack_rad: Option<f64>,
+    /// The spring's cable is anchored so that it is unstretched at this angle, rad, not at the
+    /// hanging position: −k (θ − anchor), a spring plus a constant torque k·anchor that pulls
+    /// the pendulum to one side (with `torsion_spring_nm_per_rad`).
+    #[serde(default)]
+    pub cable_anchor_rad: Option<f64>,
     /// The encoder's real counts per revolution while its header says 4096 (a mislabelled
     /// encoder).
     #[serde(default)]
@@ -126,6 +131,15 @@ impl Departures {
             return Some((
                 "cable_slack_rad",
                 "a slack beside a torsion_spring_nm_per_rad (alone it has no cable to slacken)",
+            ));
+        }
+        if bad(self.cable_anchor_rad, |v| v.abs() < std::f64::consts::PI) {
+            return Some(("cable_anchor_rad", "a finite anchor within ±π rad"));
+        }
+        if self.cable_anchor_rad.is_some() && self.torsion_spring_nm_per_rad.is_none() {
+            return Some((
+                "cable_anchor_rad",
+                "an anchor beside a torsion_spring_nm_per_rad (alone it has no cable to anchor)",
             ));
         }
         if bad(self.encoder_cpr_true, |v| v >= 1.0) {
@@ -597,6 +611,7 @@ fn synthesize_run(
     if let Some(k) = case.truth.departures.torsion_spring_nm_per_rad {
         d.kappa = k / (phys.m_kg * phys.g_m_s2 * phys.l_m);
         d.kappa_slack = case.truth.departures.cable_slack_rad.unwrap_or(0.0);
+        d.kappa_anchor = case.truth.departures.cable_anchor_rad.unwrap_or(0.0);
     }
     if let Some(spread) = case.truth.departures.mu_run_spread {
         d.m_coulomb *= 1.0 + rng.random_range(-spread..=spread);
