@@ -451,6 +451,29 @@ fn survey_departures_name_nothing() {
     assert!(wrong.is_empty(), "{wrong:#?}");
 }
 
+/// Runs the departure survey's campaign `k` of `name`, whose last drawn number is the size
+/// `term` must describe, and checks that nothing is named and that `unexplained` describes it
+/// following `variable`, with `term`'s coefficient within `rel` of that size; returns the words.
+fn described_within(name: &str, k: u64, variable: Variable, term: &str, rel: f64) -> String {
+    let (seed, b, mu, departure) = drawn_departure(name, k);
+    let size: f64 = departure.rsplit(' ').next().unwrap().parse().unwrap();
+    let s = discover_with(seed, b, mu, &departure);
+    let d = &s.discovery;
+    assert!(d.accepted().is_empty(), "named {:?}", d.accepted());
+    let desc = d.unexplained_description.as_ref().expect("a description");
+    assert_eq!(desc.variable, variable, "{desc:?}");
+    let (_, v, _) = desc
+        .terms
+        .iter()
+        .find(|(j, _, _)| LIBRARY[*j].name == term)
+        .unwrap_or_else(|| panic!("no {term} term in {desc:?}"));
+    assert!(
+        (v - size).abs() < rel * size,
+        "{departure}: described as {v:.4e} × {term}"
+    );
+    d.unexplained.clone().unwrap_or_default()
+}
+
 /// A torsion spring too weak to tell from a `position_torque` k = 1 by the share it leaves
 /// (0.028 N·m/rad, the departure survey's draw 2): sin θ and cos θ took ΔBIC −414 of it and the
 /// one term θ did 75 better (a share of 0.85, above the partial rule's 0.75). It was named, and
@@ -459,23 +482,8 @@ fn survey_departures_name_nothing() {
 /// spring, its k within 10 %.
 #[test]
 fn a_weak_torsion_spring_is_not_named_a_position_torque() {
-    let (seed, b, mu, departure) = drawn_departure("torsion_spring", 2);
-    let k: f64 = departure.rsplit(' ').next().unwrap().parse().unwrap();
-    let s = discover_with(seed, b, mu, &departure);
-    let d = &s.discovery;
-    assert!(d.accepted().is_empty(), "named {:?}", d.accepted());
-    let desc = d.unexplained_description.as_ref().expect("a description");
-    assert_eq!(desc.variable, Variable::Angle, "{desc:?}");
-    let theta = desc
-        .terms
-        .iter()
-        .find(|(j, _, _)| LIBRARY[*j].name == "θ")
-        .unwrap_or_else(|| panic!("no linear θ term in {desc:?}"));
-    assert!(
-        (theta.1 - k).abs() < 0.1 * k,
-        "spring {k:.4e} described as {:.4e}",
-        theta.1
-    );
+    let words = described_within("torsion_spring", 2, Variable::Angle, "θ", 0.1);
+    assert!(words.contains("a spring"), "{words}");
 }
 
 /// A dry torque growing fast (4.5e-4 N·m/s, the departure survey's draw 0) fitted well enough
@@ -485,28 +493,8 @@ fn a_weak_torsion_spring_is_not_named_a_position_torque() {
 /// within 25 %.
 #[test]
 fn a_fast_growing_dry_torque_is_not_named_a_constant_one() {
-    let (seed, b, mu, departure) = drawn_departure("dry_torque_growth", 0);
-    let rate: f64 = departure.rsplit(' ').next().unwrap().parse().unwrap();
-    let s = discover_with(seed, b, mu, &departure);
-    let d = &s.discovery;
-    assert!(d.accepted().is_empty(), "named {:?}", d.accepted());
-    let desc = d.unexplained_description.as_ref().expect("a description");
-    assert_eq!(desc.variable, Variable::Time, "{desc:?}");
-    let growth = desc
-        .terms
-        .iter()
-        .find(|(j, _, _)| LIBRARY[*j].name == "t sgn θ̇")
-        .unwrap_or_else(|| panic!("no t sgn θ̇ term in {desc:?}"));
-    assert!(
-        (growth.1 - rate).abs() < 0.25 * rate,
-        "growth {rate:.4e} described as {:.4e}",
-        growth.1
-    );
-    assert!(d
-        .unexplained
-        .as_deref()
-        .unwrap_or_default()
-        .contains("growing with time"));
+    let words = described_within("dry_torque_growth", 0, Variable::Time, "t sgn θ̇", 0.25);
+    assert!(words.contains("growing with time"), "{words}");
 }
 
 /// A 0.029 rad encoder backlash (the departure survey's draw 0) was named a −0.74 ms
