@@ -130,6 +130,17 @@ fn assert_found(s: &DiscoverSummary, effect: &str, truth: f64, rel: f64, abs: f6
     );
 }
 
+/// The surveys' `SURVEY_SEED` (default 0) as an offset to every draw's tag and campaign seed:
+/// other seeds draw other designs, sizes and damping, none of them the ones the README quotes
+/// (tags and seeds stay below 100 000 at seed 0).
+fn survey_seed_offset() -> u64 {
+    100_000
+        * std::env::var("SURVEY_SEED")
+            .ok()
+            .and_then(|v| v.parse::<u64>().ok())
+            .unwrap_or(0)
+}
+
 fn rng(tag: u64) -> rand_chacha::ChaCha8Rng {
     rand_chacha::ChaCha8Rng::seed_from_u64(0x5EED_0000 + tag)
 }
@@ -321,6 +332,7 @@ fn regression_issue_5_finds_speed_drift() {
 
 /// Survey (slow, by hand with `--ignored`): campaigns with nothing hidden, drawn damping and
 /// seeds; prints what (if anything) each names. The false-alarm rate in the issue 5 note.
+/// `SURVEY_SEED=s` draws other campaigns (see [`survey_seed_offset`]).
 #[test]
 #[ignore = "survey for issue 12: SURVEY_N nothing-hidden drawn designs (default 8); SURVEY_N=50 is ~20 minutes"]
 fn survey_issue_5_false_alarm_rate() {
@@ -328,7 +340,8 @@ fn survey_issue_5_false_alarm_rate() {
         .ok()
         .and_then(|v| v.parse().ok())
         .unwrap_or(8);
-    let mut r = rng(40);
+    let off = survey_seed_offset();
+    let mut r = rng(40 + off);
     let (mut alarms, mut unexplained) = (0, 0);
     // `SURVEY_ONE=fa:k` re-runs campaign k alone (`SURVEY_KEEP=DIR` keeps it).
     let one = std::env::var("SURVEY_ONE").ok();
@@ -338,7 +351,7 @@ fn survey_issue_5_false_alarm_rate() {
         if one.as_deref().is_some_and(|o| o != format!("fa:{k}")) {
             continue;
         }
-        let s = discover(300 + k, Base::Reference, 0.0, b, mu, "");
+        let s = discover(300 + k + off, Base::Reference, 0.0, b, mu, "");
         let accepted = s.discovery.accepted();
         alarms += usize::from(!accepted.is_empty());
         unexplained += usize::from(s.discovery.unexplained.is_some());
@@ -353,6 +366,23 @@ fn survey_issue_5_false_alarm_rate() {
         alarms as f64 <= (n as f64 / 50.0).ceil(),
         "false alarms in {alarms} of {n}"
     );
+}
+
+/// Campaign 9 of the false-alarm survey at `SURVEY_SEED=1` (nothing hidden): the second look
+/// named a constant dry torque whose trajectory refit was 7.3e-8 N·m, on a held-out E_θ fall of
+/// 6.2 % ± 2.5 % that refitting the other parameters along it had made. The trajectories, the
+/// view that sees a dry torque on the second look, must tell it from its absence.
+#[test]
+fn a_dry_torque_refitted_to_nothing_is_not_named_on_the_second_look() {
+    let off = 100_000;
+    let mut r = rng(40 + off);
+    let (mut b, mut mu) = (0.0, 0.0);
+    for _ in 0..=9 {
+        b = r.random_range(0.3..0.7);
+        mu = r.random_range(0.08..0.2);
+    }
+    let s = discover(300 + 9 + off, Base::Reference, 0.0, b, mu, "");
+    assert!(s.discovery.accepted().is_empty(), "{:#?}", s.discovery.rows);
 }
 
 /// `viscous_linear` is a reference-model term: it is found where the model in hand lacks it,
@@ -696,6 +726,7 @@ fn a_description_in_a_catalogue_entrys_shape_says_which() {
 /// Survey (slow, by hand with `--ignored`): every catalogue effect hidden alone
 /// `SURVEY_N` times (default 3) with drawn sizes and fresh seeds, then pairs; prints one line per
 /// campaign (named alone? estimate error; `unexplained`?) and the hit rate. For the issue 5 note.
+/// `SURVEY_SEED=s` draws other designs, sizes and damping (see [`survey_seed_offset`]).
 #[test]
 #[ignore = "survey for issue 12: 12 effects × SURVEY_N (default 3) drawn designs + 4 pairs; SURVEY_N=5 is ~30 minutes"]
 fn survey_issue_5_every_effect() {
@@ -735,6 +766,7 @@ fn survey_issue_5_every_effect() {
         .unwrap_or(1.0);
     // `SURVEY_ONE=effect:k` re-runs one campaign of the survey (`SURVEY_KEEP=DIR` keeps it).
     let one = std::env::var("SURVEY_ONE").ok();
+    let off = survey_seed_offset();
     for (e_idx, effect) in effects.iter().enumerate() {
         for k in 0..n.max(5) {
             if one
@@ -743,9 +775,9 @@ fn survey_issue_5_every_effect() {
             {
                 continue;
             }
-            let mut r = rng(1000 + 100 * e_idx as u64 + k);
+            let mut r = rng(1000 + 100 * e_idx as u64 + k + off);
             let (truth, spec, base, a, b, mu) = draw_scaled(effect, &mut r, size_scale);
-            let s = discover(5000 + 100 * e_idx as u64 + k, base, a, b, mu, &spec);
+            let s = discover(5000 + 100 * e_idx as u64 + k + off, base, a, b, mu, &spec);
             let accepted = s.discovery.accepted();
             let row = s.discovery.row(effect);
             let est = row.map_or(f64::NAN, |r| r.estimate);
@@ -779,11 +811,11 @@ fn survey_issue_5_every_effect() {
         if one.as_deref().is_some_and(|o| o != format!("pair:{p_idx}")) {
             continue;
         }
-        let mut r = rng(3000 + p_idx as u64);
+        let mut r = rng(3000 + p_idx as u64 + off);
         let (t1, s1, _, _, _, _) = draw(e1, &mut r);
         let (t2, s2, _, _, _, _) = draw(e2, &mut r);
         let s = discover(
-            7000 + p_idx as u64,
+            7000 + p_idx as u64 + off,
             Base::Reference,
             0.0,
             0.5,
