@@ -1703,9 +1703,11 @@ pub fn discover(
         // extra inertia whose refit sat at its widened bound, 0.04. (A size at 0 with the range
         // starting there is the effect's absence, which the agreement below judges.)
         let refit_pinned = size_index.is_some_and(|i| {
-            let (lo, hi) = spec.range(spec.params[i]);
-            let tol = 1e-3 * (hi - lo);
-            x[i] >= hi - tol || (lo != 0.0 && x[i] <= lo + tol)
+            let p = spec.params[i];
+            match spec.at_end(p, x[i]) {
+                Some(pendulum_process::fit::Side::Lower) => spec.range(p).0 != 0.0,
+                side => side.is_some(),
+            }
         });
         let agree = !refit_pinned
             && views_agree(

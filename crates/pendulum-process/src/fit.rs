@@ -231,8 +231,9 @@ pub struct ModelSpec {
 /// range's span on that side): up to 8 times the catalogue's span.
 pub const MAX_WIDENINGS: usize = 3;
 
-#[derive(Clone, Copy)]
-enum Side {
+/// An end of a search range.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Side {
     Lower,
     Upper,
 }
@@ -275,6 +276,20 @@ impl ModelSpec {
             .unwrap_or_else(|| p.bounds())
     }
 
+    /// The end of `p`'s search range that `v` sits at (within a thousandth of the span), if any:
+    /// there the range, not the data, set the value.
+    pub fn at_end(&self, p: FitParam, v: f64) -> Option<Side> {
+        let (lo, hi) = self.range(p);
+        let tol = 1e-3 * (hi - lo);
+        if v >= hi - tol {
+            Some(Side::Upper)
+        } else if v <= lo + tol {
+            Some(Side::Lower)
+        } else {
+            None
+        }
+    }
+
     /// Widens the search range of each parameter whose value in `x` (one per [`Self::params`]) sits
     /// at an end of it that is a search convenience, not physics, by doubling the span on that
     /// side; returns the names widened. A catalogue range is the search's: the data may put a
@@ -290,16 +305,10 @@ impl ModelSpec {
             if ep.def().integer || !v.is_finite() {
                 continue;
             }
-            let (lo, hi) = self.range(p);
-            let tol = 1e-3 * (hi - lo);
-            let side = if v >= hi - tol {
-                Side::Upper
-            } else if v <= lo + tol {
-                Side::Lower
-            } else {
+            let Some(side) = self.at_end(p, v) else {
                 continue;
             };
-            if let Some(new) = widened_range(p, (lo, hi), side) {
+            if let Some(new) = widened_range(p, self.range(p), side) {
                 self.ranges.insert(p.spec_name().into(), new);
                 widened.push(p.name());
             }
