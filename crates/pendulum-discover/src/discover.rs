@@ -913,6 +913,20 @@ fn extend(
 /// runs' equation error must agree as well.)
 pub const SECOND_LOOK_GAIN_FACTOR: f64 = 2.0;
 
+/// The second look when the base model's own fit is pinned at its search range: the model in
+/// hand does not follow the runs at all, and the screen may not see why. A hidden 0.05 rad
+/// encoder offset on a heavily damped design (b 0.5 N·s/m, μ 0.15, every forced stretch at
+/// rest) read as a pendulum held off vertical by friction: the base fit went to b = 1 and
+/// μ = 0.25, its bounds, while the equation error, which leaves out the windows where the
+/// pendulum may stick, had too few swings to see the offset (ΔBIC +4.2, an estimate right to
+/// 0.4 % inside an interval of ±0.24 rad). Then every first-round candidate is refitted, and
+/// judged as the dry frictions' second look is, except that the identify runs' own view may
+/// stand in for the validate runs' equation error: the candidate's refit takes every base
+/// parameter off the bounds that pinned it (the screen's joint estimate of the damping beside
+/// the candidate is where that refit starts). A model that then fits is the identify runs'
+/// verdict, the held-out E_θ fall beyond twice its bar the validate runs'.
+pub const PINNED_LOOK: &str = "the base model's fit was pinned at its search range";
+
 enum SecondLook {
     NotStarted,
     /// Evaluating the queue; (effect, passes, held-out gain) so far.
@@ -928,7 +942,9 @@ enum SecondLook {
 impl SecondLook {
     /// The next candidate to evaluate, starting the look when `eligible` (nothing named or
     /// refused by the screen's own route).
-    fn next(&mut self, eligible: bool, first_round: &[Screened]) -> Option<Screened> {
+    /// With the base model pinned at its search range (`pinned`), every first-round candidate is
+    /// looked at again, not only the dry frictions (see [`PINNED_LOOK`]).
+    fn next(&mut self, eligible: bool, pinned: bool, first_round: &[Screened]) -> Option<Screened> {
         if let SecondLook::NotStarted = self {
             if !eligible {
                 return None;
@@ -937,8 +953,9 @@ impl SecondLook {
             let queue = first_round
                 .iter()
                 .filter(|s| {
-                    pendulum_model::effects::by_name(&s.candidate.effect)
-                        .is_some_and(|e| e.sets_sticking_capacity())
+                    (pinned
+                        || pendulum_model::effects::by_name(&s.candidate.effect)
+                            .is_some_and(|e| e.sets_sticking_capacity()))
                         // A replacement (the bearing load) must not fit the equation error worse
                         // than the column it replaces (added columns never do).
                         && (s.candidate.replaces.is_none() || s.delta_bic <= 0.0)
@@ -1481,12 +1498,25 @@ pub fn discover(
     let mut queue: std::collections::VecDeque<_> = screened.chosen.iter().cloned().collect();
     let mut next = queue.pop_front();
     let mut round = 0;
-    // The second look at the dry frictions (see [`SecondLook`]).
+    // The second look at the dry frictions (see [`SecondLook`]), at every candidate when the base
+    // fit is pinned at its search range (see [`PINNED_LOOK`]).
+    let base_pins: Vec<(FitParam, pendulum_process::fit::Side)> = base_fit
+        .spec
+        .params
+        .iter()
+        .zip(&base_fit.params)
+        .filter_map(|(&p, &v)| match base_fit.spec.at_end(p, v)? {
+            // A term the fit does not use.
+            pendulum_process::fit::Side::Lower if base_fit.spec.range(p).0 == 0.0 => None,
+            side => Some((p, side)),
+        })
+        .collect();
+    let base_pinned = !base_pins.is_empty();
     let mut second = SecondLook::NotStarted;
     loop {
         let sc = match next.take() {
             Some(sc) => sc,
-            None => match second.next(round == 0 && refused.is_none(), first_round) {
+            None => match second.next(round == 0 && refused.is_none(), base_pinned, first_round) {
                 Some(sc) => sc,
                 None => break,
             },
@@ -1729,6 +1759,17 @@ pub fn discover(
             && practically_significant(&c.effect, est, jitter_s, bob_inertia)
             && possible
             && agree;
+        // With the base pinned (see [`PINNED_LOOK`]): does the candidate's refit take each base
+        // parameter off the end of the search range that held it? (It may leave another at an
+        // end: on a heavily damped design whose runs mostly rest, a refit freeing b and μ traded
+        // b for the quadratic drag a, at its bound, while the offset it held was right to 0.3 %.)
+        let unpins = !base_pins.is_empty()
+            && base_pins.iter().all(|&(p, side)| {
+                spec.params
+                    .iter()
+                    .position(|&q| q == p)
+                    .is_none_or(|i| base_fit.spec.at_end(p, x[i]) != Some(side))
+            });
         let accepted = if second_look {
             // Both held-out views: the validate runs' E_θ beyond twice the screen route's bar,
             // and their equation error's fall beyond its own (the identify runs' equation error
@@ -1744,7 +1785,7 @@ pub fn discover(
             let passes = plausible
                 && informative
                 && gain > SECOND_LOOK_GAIN_FACTOR * gain_needed
-                && eq_gain > eq_needed;
+                && (eq_gain > eq_needed || unpins);
             second.record(&c.effect, passes, gain)
         } else {
             plausible && excludes_zero && sc.delta_bic < cfg.screen_threshold && held_out
@@ -1822,7 +1863,9 @@ pub fn discover(
                 } else {
                     String::new()
                 },
-                if second_look {
+                if second_look && base_pinned {
+                    "second look (the base model's fit was pinned at its search range; judged on the held-out runs and on whether the candidate's refit frees it)"
+                } else if second_look {
                     "second look (the identify runs' equation error cannot see it; judged on the held-out runs)"
                 } else if excludes_zero {
                     "interval excludes 0"
@@ -1858,6 +1901,11 @@ pub fn discover(
             ),
         };
         let mut row = row;
+        if accepted && second_look && unpins && eq_gain <= eq_needed {
+            row.note.push_str(
+                "; with it the base parameters' refit leaves the bounds that pinned the base fit",
+            );
+        }
         if accepted {
             if let Some((v, corr)) = refined {
                 view = v;
