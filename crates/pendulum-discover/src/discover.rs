@@ -1713,7 +1713,7 @@ pub fn discover(
             // "Not significantly worse" confirms the screen's value only where the trajectories
             // can tell the effect from its absence at all: through chaos they often cannot, and
             // a 0.020 kg·m² "extra inertia" (the refit: 0.00045) that stood in for a
-            // a mislabelled encoder passed a profile test with no power. A switch's absence is
+            // mislabelled encoder passed a profile test with no power. A switch's absence is
             // the current model without it, refitted by the same procedure: a 0.022 rad encoder
             // backlash through chaos was named `bearing_load_base_accel`, the screen's μ 0.117
             // [0.106, 0.129] "fitting the trajectories" as well as the refit's 0.090, which
