@@ -1638,15 +1638,20 @@ pub fn discover(
         let val = validate(&val_runs, &spec, &x, &cfg.validate)?;
         // Compare with the current model refitted by the same procedure, so that the gain is
         // the effect's and not the local refit's.
-        if baseline[cache].is_none() {
-            let (xc, _, _) = refit_zeroed(&current.spec, &current.params);
-            let v = validate(&val_runs, &current.spec, &xc, &cfg.validate)?;
-            baseline[cache] = Some((xc, v));
-        }
+        let (current_refit, current_refit_val) = match &baseline[cache] {
+            Some(b) => b.clone(),
+            None => {
+                let (xc, _, _) = refit_zeroed(&current.spec, &current.params);
+                let v = validate(&val_runs, &current.spec, &xc, &cfg.validate)?;
+                baseline[cache] = Some((xc.clone(), v.clone()));
+                (xc, v)
+            }
+        };
         // The better of the current model's two validations (as fitted, and refitted locally).
-        let before_val = match &baseline[cache] {
-            Some((_, b)) if e_total(b) < e_total(&current_val) => b,
-            _ => &current_val,
+        let before_val = if e_total(&current_refit_val) < e_total(&current_val) {
+            &current_refit_val
+        } else {
+            &current_val
         };
         let before = e_total(before_val);
         let after = e_total(&val);
@@ -1727,17 +1732,17 @@ pub fn discover(
                     );
                     g0 < -n0
                 }
-                Some(_) => baseline[cache].as_ref().is_none_or(|(xc, _)| {
+                Some(_) => {
                     let (g0, n0) = trajectory_substitution(
                         &traj_runs,
                         &current.spec,
                         &seg_x,
-                        xc,
+                        &current_refit,
                         &traj_ics,
                         run_zeros,
                     );
                     g0 < -n0
-                }),
+                }
                 None => true,
             };
             (g >= -n && informative, informative)
