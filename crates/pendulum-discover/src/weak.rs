@@ -294,13 +294,21 @@ pub fn set_weights(rows: &mut [WeakRow], residuals: &[f64]) {
     }
 }
 
-/// Adds one column per identify run but the last for the encoder's per-run zeroing error: the
-/// count is zeroed at every power-on to within a few counts (rig.md), and an offset θ_r adds
-/// θ_r (1 + A_y) cos θ to run r's torque. A 2-count zero error is 3e-3 m g l, as large as a
-/// plausible constant dry torque, and of a different sign in each run: one global offset column
-/// cannot absorb it, and what is left was mistaken for (or hid) other terms. The columns are
-/// sum-to-zero contrasts (run k minus the last identify run), so the global offset column
-/// (`offset`) still estimates the offset common to all runs, the effect `encoder_offset`.
+/// Adds one column per identify run but one (the reference) for the encoder's per-run zeroing
+/// error: the count is zeroed at every power-on to within a few counts (rig.md), and an offset
+/// θ_r adds θ_r (1 + A_y) cos θ to run r's torque. A 2-count zero error is 3e-3 m g l, as large
+/// as a plausible constant dry torque, and of a different sign in each run: one global offset
+/// column cannot absorb it, and what is left was mistaken for (or hid) other terms. The columns
+/// are contrasts constrained so that the global offset column (`offset`) estimates the
+/// precision-weighted mean of the runs' zeros, the effect `encoder_offset`: run r's zero is
+/// θ + c_r, with Σ w_r c_r = 0, w_r the information run r's rows hold on its own zero
+/// ([`zero_information`]: what of the offset column the reference model's damping terms and the
+/// inertia column cannot take over in that run). The reference is the best-informed run, whose
+/// rows carry −(w_r/w_ref) x in run r's column. (A plain mean, with the last run as reference,
+/// let a run of 4 windows decide the common offset: beside an extra inertia its interval was
+/// ±151 rad, while every run's free decay swung about −0.03 rad; weighting by the column's bare
+/// Σ x² still left it at ±0.03 rad, because those 4 windows could not tell the run's zero from
+/// its damping.)
 /// Returns the new column indices (empty with fewer than two identify runs). Validate rows get
 /// zeros: their own zero errors are not fitted.
 pub fn add_zero_error_contrasts(rows: &mut [WeakRow], identify_runs: &[usize]) -> Vec<usize> {
@@ -308,20 +316,86 @@ pub fn add_zero_error_contrasts(rows: &mut [WeakRow], identify_runs: &[usize]) -
     let Some(offset) = observation_column() else {
         return Vec::new();
     };
-    let k = identify_runs.len().saturating_sub(1);
-    let last = identify_runs.last().copied();
+    let mut info: Vec<f64> = identify_runs
+        .iter()
+        .map(|&q| zero_information(rows, q, offset))
+        .collect();
+    if info.iter().all(|w| *w <= 0.0) {
+        info.iter_mut().for_each(|w| *w = 1.0);
+    }
+    // The best-informed run is the reference (ties: the last, as before).
+    let Some(reference) = (0..identify_runs.len())
+        .rev()
+        .max_by(|&a, &b| info[a].total_cmp(&info[b]))
+    else {
+        return Vec::new();
+    };
+    let others: Vec<usize> = (0..identify_runs.len())
+        .filter(|&j| j != reference)
+        .collect();
+    let w_ref = info[reference];
+    let ratios: Vec<f64> = others
+        .iter()
+        .map(|&j| if w_ref > 0.0 { info[j] / w_ref } else { 1.0 })
+        .collect();
     for r in rows.iter_mut() {
         r.x.resize(width, 0.0);
         let off = r.x[offset];
-        let mut extra = vec![0.0; k];
-        if let Some(j) = identify_runs[..k].iter().position(|&q| q == r.run) {
-            extra[j] = off;
-        } else if Some(r.run) == last {
-            extra.iter_mut().for_each(|v| *v = -off);
+        let mut extra = vec![0.0; others.len()];
+        if let Some(k) = others.iter().position(|&j| identify_runs[j] == r.run) {
+            extra[k] = off;
+        } else if r.run == identify_runs[reference] {
+            extra
+                .iter_mut()
+                .zip(&ratios)
+                .for_each(|(v, q)| *v = -q * off);
         }
         r.x.extend(extra);
     }
-    (width..width + k).collect()
+    (width..width + others.len()).collect()
+}
+
+/// The information run `run`'s rows hold on the run's own encoder zero: the part of the offset
+/// column's Σ x² that the reference model's damping columns and the inertia column, fitted to
+/// the same rows, leave (the residual sum of squares of the column regressed on them). 0 where
+/// the run has too few rows to tell them apart.
+fn zero_information(rows: &[WeakRow], run: usize, offset: usize) -> f64 {
+    let others: Vec<usize> = ["viscous_linear", "viscous_quadratic", "coulomb_bearing"]
+        .iter()
+        .filter_map(|e| column_of(e))
+        .chain(mass_column())
+        .collect();
+    let mine: Vec<&WeakRow> = rows.iter().filter(|r| r.run == run).collect();
+    // (A column this run's rows do not hold takes nothing over.)
+    let others: Vec<usize> = others
+        .into_iter()
+        .filter(|&c| mine.iter().any(|r| r.x.get(c).is_some_and(|v| *v != 0.0)))
+        .collect();
+    let y: Vec<f64> = mine
+        .iter()
+        .map(|r| r.x.get(offset).copied().unwrap_or(0.0))
+        .collect();
+    let ss: f64 = y.iter().map(|v| v * v).sum();
+    if others.is_empty() {
+        return ss;
+    }
+    if mine.len() <= others.len() {
+        return 0.0;
+    }
+    let design: Vec<Vec<f64>> = mine
+        .iter()
+        .map(|r| {
+            others
+                .iter()
+                .map(|&c| r.x.get(c).copied().unwrap_or(0.0))
+                .collect()
+        })
+        .collect();
+    match pendulum_numerics::ols(&design, &y) {
+        Ok(fit) => fit.rss.clamp(0.0, ss),
+        // Columns collinear among themselves in this run: count the bare column.
+        Err(_) => ss,
+    }
 }
 
 /// Weak-form settings.
@@ -778,19 +852,24 @@ mod contrast_tests {
         }
     }
 
-    /// With per-run offsets θ_r, the offset column estimates their plain mean and each run's own
-    /// offset is the mean plus its contrast; validate rows (run 3) get zero contrasts.
+    /// With per-run offsets θ_r, the offset column estimates their mean weighted by each run's
+    /// information (Σ x²), and each run's own offset is the mean plus its contrast; validate
+    /// rows (run 3) get zero contrasts.
     #[test]
     fn zero_error_contrasts_split_common_and_per_run_offsets() {
         let offsets = [0.003, -0.002, 0.0015];
+        let lens = [40, 70, 25];
         let mut rows = Vec::new();
+        let mut info = [0.0; 3];
         for (r, th) in offsets.iter().enumerate() {
-            for i in 0..40 {
+            for i in 0..lens[r] {
                 let x = ((i * 7 + r * 3) as f64 * 0.37).cos() + 0.2;
+                info[r] += x * x;
                 rows.push(row(r, x, th * x));
             }
         }
         rows.push(row(3, 1.0, 0.5));
+        let n_id = rows.len() - 1;
         let cols = add_zero_error_contrasts(&mut rows, &[0, 1, 2]);
         let n = columns().len();
         assert_eq!(cols, vec![n, n + 1]);
@@ -798,16 +877,54 @@ mod contrast_tests {
         let offset = observation_column().unwrap();
         let mut all = vec![offset];
         all.extend(&cols);
-        let fit = crate::screen::ols(&rows[..120], &all).unwrap();
-        let mean = offsets.iter().sum::<f64>() / 3.0;
+        let fit = crate::screen::ols(&rows[..n_id], &all).unwrap();
+        let mean =
+            offsets.iter().zip(&info).map(|(t, w)| t * w).sum::<f64>() / info.iter().sum::<f64>();
         let (m, _) = fit.coef_of(offset).unwrap();
         assert!((m - mean).abs() < 1e-12, "{m} vs {mean}");
-        for (k, th) in offsets[..2].iter().enumerate() {
+        // Run 1 (the best informed) is the reference; runs 0 and 2 have their own contrasts.
+        for (k, r) in [0, 2].into_iter().enumerate() {
             let (d, _) = fit.coef_of(cols[k]).unwrap();
-            assert!((m + d - th).abs() < 1e-12);
+            assert!((m + d - offsets[r]).abs() < 1e-12);
         }
-        // The last run's offset is the mean minus the other contrasts.
-        let d_sum: f64 = cols.iter().map(|&c| fit.coef_of(c).unwrap().0).sum();
-        assert!((m - d_sum - offsets[2]).abs() < 1e-12);
+    }
+
+    /// A run whose rows cannot tell its own zero from the damping cannot make the common offset
+    /// unknowable: its interval is that of the well-informed runs. Run 2's offset column is
+    /// nearly its bearing-friction column (which no other run's rows hold), as large as the other
+    /// runs' by Σ x², so only the information left after the damping columns weighs it right.
+    #[test]
+    fn a_run_that_cannot_see_its_zero_does_not_decide_the_common_offset() {
+        let offsets = [0.002, -0.001, 0.0005];
+        let lens = [200, 200, 200];
+        let mu = column_of("coulomb_bearing").unwrap();
+        let mut rows = Vec::new();
+        let mut seed = 7u64;
+        let mut noise = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 1e-3
+        };
+        for (r, th) in offsets.iter().enumerate() {
+            for i in 0..lens[r] {
+                let x = ((i * 5 + r) as f64 * 0.61).cos();
+                let mut w = row(r, x, th * x + noise());
+                if r == 2 {
+                    w.x[mu] = x + 0.02 * (i as f64 * 1.37).sin();
+                    w.target += 0.03 * x;
+                }
+                rows.push(w);
+            }
+        }
+        let cols = add_zero_error_contrasts(&mut rows, &[0, 1, 2]);
+        let offset = observation_column().unwrap();
+        let mut all = vec![offset, mu];
+        all.extend(&cols);
+        let fit = crate::screen::ols(&rows, &all).unwrap();
+        let (m, se) = fit.coef_of(offset).unwrap();
+        let good = (offsets[0] + offsets[1]) / 2.0;
+        assert!(se < 1e-4, "common offset's standard error {se}");
+        assert!((m - good).abs() < 5.0 * se.max(1e-6), "{m} vs {good}");
     }
 }
