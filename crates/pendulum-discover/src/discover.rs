@@ -1679,7 +1679,39 @@ pub fn discover(
         let (current_refit, current_refit_val) = match &baseline[cache] {
             Some(b) => b.clone(),
             None => {
-                let (xc, _, _, _) = refit_zeroed(&current.spec, &current.params);
+                // From the current fit, and from the screen's joint estimate of its damping (the
+                // candidate's refit starts from the screen's, so must its absence's: a base fit
+                // stuck at a = 0.87, b = 0.016 on a nothing-hidden campaign was left there by
+                // its own local refit, while a constant dry torque's refit, started from the
+                // screen's b = 0.44, took 90 % off the held-out E_θ and was named).
+                let (xc, fc, _, _) = refit_zeroed(&current.spec, &current.params);
+                let screened_start = ols(&view.id_rows, &current_cols).map(|f0| {
+                    let mut start = current.params.clone();
+                    for (v, p) in start.iter_mut().zip(&current.spec.params) {
+                        if matches!(p, FitParam::B | FitParam::A | FitParam::Mu) {
+                            if let Some((c, _)) = p
+                                .effect_name()
+                                .and_then(crate::weak::column_of)
+                                .and_then(|col| f0.coef_of(col))
+                                .filter(|(c, _)| c.is_finite())
+                            {
+                                *v = c.max(0.0);
+                            }
+                        }
+                    }
+                    start
+                });
+                let xc = match screened_start.filter(|st| *st != current.params) {
+                    Some(st) => {
+                        let (xs, fs, _, _) = refit_zeroed(&current.spec, &st);
+                        if fs < fc {
+                            xs
+                        } else {
+                            xc
+                        }
+                    }
+                    None => xc,
+                };
                 let v = validate(&val_runs, &current.spec, &xc, &cfg.validate)?;
                 baseline[cache] = Some((xc.clone(), v.clone()));
                 (xc, v)
