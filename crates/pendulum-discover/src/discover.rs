@@ -1051,6 +1051,24 @@ const WEIGHT_FIT_MAX_GROUP: u32 = 4;
 /// from the dry base) such a run alone pulled the refit of b from 0.48 to 0.
 pub const STILL_SPAN_STEPS: f64 = 10.0;
 
+/// `x` (parameters of `spec`) with the reference model's damping terms (b, a, μ) set to the
+/// screen's joint estimate `fit` where it has them (finite, floored at 0).
+fn with_screened_damping(spec: &ModelSpec, x: &mut [f64], fit: &crate::screen::Ols) {
+    for (v, p) in x.iter_mut().zip(&spec.params) {
+        if !matches!(p, FitParam::B | FitParam::A | FitParam::Mu) {
+            continue;
+        }
+        if let Some((c, _)) = p
+            .effect_name()
+            .and_then(crate::weak::column_of)
+            .and_then(|col| fit.coef_of(col))
+            .filter(|(c, _)| c.is_finite())
+        {
+            *v = c.max(0.0);
+        }
+    }
+}
+
 /// Per run, the initial state (two values per run, in run order) from which the model `x`
 /// follows the run better: the one `held` (the base fit's, fitted with the base model) or the
 /// one measured at t = 0 (the local polynomial's, which no model shaped). The base fit's states
@@ -1625,18 +1643,7 @@ pub fn discover(
         // The base's damping terms start from the screen's joint estimate with the candidate in,
         // not from the base fit, whose terms absorbed what the candidate now explains (a
         // constant dry torque inflates μ): a local refit from there need not find its way back.
-        for (i, p) in spec.params.iter().enumerate() {
-            let si = match p {
-                FitParam::B | FitParam::A | FitParam::Mu => p
-                    .effect_name()
-                    .and_then(crate::weak::column_of)
-                    .and_then(|col| fit.coef_of(col)),
-                _ => None,
-            };
-            if let Some(v) = si.map(|(v, _)| v).filter(|v| v.is_finite()) {
-                x0[i] = v.max(0.0);
-            }
-        }
+        with_screened_damping(&spec, &mut x0, &fit);
         // A switch refits the reference parameter it changes from the screen's value (μ on the
         // bearing load with the base's acceleration).
         if effect.params().is_empty() {
@@ -1687,18 +1694,7 @@ pub fn discover(
                 let (xc, fc, _, _) = refit_zeroed(&current.spec, &current.params);
                 let screened_start = ols(&view.id_rows, &current_cols).map(|f0| {
                     let mut start = current.params.clone();
-                    for (v, p) in start.iter_mut().zip(&current.spec.params) {
-                        if matches!(p, FitParam::B | FitParam::A | FitParam::Mu) {
-                            if let Some((c, _)) = p
-                                .effect_name()
-                                .and_then(crate::weak::column_of)
-                                .and_then(|col| f0.coef_of(col))
-                                .filter(|(c, _)| c.is_finite())
-                            {
-                                *v = c.max(0.0);
-                            }
-                        }
-                    }
+                    with_screened_damping(&current.spec, &mut start, &f0);
                     start
                 });
                 let xc = match screened_start.filter(|st| *st != current.params) {
