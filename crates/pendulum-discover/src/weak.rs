@@ -323,7 +323,8 @@ pub fn add_zero_error_contrasts(rows: &mut [WeakRow], identify_runs: &[usize]) -
     if info.iter().all(|w| *w <= 0.0) {
         info.iter_mut().for_each(|w| *w = 1.0);
     }
-    // The best-informed run is the reference (ties: the last, as before).
+    // The best-informed run is the reference (on a tie, the first: `max_by` keeps the last of the
+    // reversed order).
     let Some(reference) = (0..identify_runs.len())
         .rev()
         .max_by(|&a, &b| info[a].total_cmp(&info[b]))
