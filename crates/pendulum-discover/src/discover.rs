@@ -1401,8 +1401,9 @@ fn segment_pairs(before: &[RunFit], after: &[RunFit]) -> (Vec<f64>, Vec<f64>) {
     (b, a)
 }
 
-/// Held-out E_θ gain of `after` over `before` and the noise it must beat.
-fn heldout_gain(before: &[RunFit], after: &[RunFit]) -> (f64, f64) {
+/// Held-out E_θ gain of `after` over `before` and the noise it must beat (discover's held-out
+/// test; public so that a survey can ask the same of the truth itself).
+pub fn heldout_gain(before: &[RunFit], after: &[RunFit]) -> (f64, f64) {
     let (b, a) = segment_pairs(before, after);
     paired_gain(&b, &a)
 }
