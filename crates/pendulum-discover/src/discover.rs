@@ -1728,12 +1728,32 @@ pub fn discover(
                 (xc, v)
             }
         };
-        // The better of the current model's two validations (as fitted, and refitted locally).
-        let before_val = if e_total(&current_refit_val) < e_total(&current_val) {
-            &current_refit_val
-        } else {
-            &current_val
+        // The current model once more, refitted from where the candidate's own refit left its
+        // other terms (the effect's size at 0: the profile through its absence). A refit that
+        // adds a term also moves the others, and can leave a basin the current model's own
+        // refits did not (a base fit stuck at a = 0.73, b = 0.020 beside a growing dry torque
+        // outside the catalogue: a 3.7e-4 N·m constant one was credited with the 14 % that the
+        // damping's repair took off the held-out E_θ). From there the gain is the effect's.
+        let absence_val = match size_index {
+            Some(i) if !effect.params().is_empty() && spec.range(spec.params[i]).0 <= 0.0 => {
+                let mut start = x.clone();
+                start[i] = 0.0;
+                let xa = refit_profile(&traj_runs, &spec, &start, &traj_ics, cfg.refit_evals, i);
+                Some(validate(&val_runs, &spec, &xa, &cfg.validate)?)
+            }
+            _ => None,
         };
+        // The best of the current model's validations (as fitted, refitted locally, and
+        // refitted from the candidate's refit without the effect).
+        let before_val = [
+            Some(&current_val),
+            Some(&current_refit_val),
+            absence_val.as_ref(),
+        ]
+        .into_iter()
+        .flatten()
+        .min_by(|a, b| e_total(a).total_cmp(&e_total(b)))
+        .unwrap_or(&current_val);
         let before = e_total(before_val);
         let after = e_total(&val);
         let (gain, noise) = heldout_gain(before_val, &val);
