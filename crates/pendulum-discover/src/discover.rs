@@ -2263,7 +2263,7 @@ pub fn discover(
     // Runs the model in hand does not follow at all: its predictions from the measured state
     // miss by half or more of how far the angle moves (an encoder counting twice a turn: E_θ
     // of 996, 1468 and 3011 on chaotic runs where a fitting model leaves a few units).
-    let not_followed: Vec<String> = if current.spec == base_fit.spec {
+    let not_followed_runs: Vec<(&str, f64)> = if current.spec == base_fit.spec {
         base_fit
             .runs
             .iter()
@@ -2271,25 +2271,28 @@ pub fn discover(
             .filter_map(|f| {
                 let run = id_runs.iter().chain(&val_runs).find(|r| r.id == f.id)?;
                 let ratio = pendulum_process::identify::misfit_ratio(run, f.e_theta)?;
-                (ratio >= MISFIT_RATIO).then(|| format!("{} ({:.0} %)", f.id, 100.0 * ratio))
+                (ratio >= MISFIT_RATIO).then_some((f.id.as_str(), ratio))
             })
             .collect()
     } else {
         Vec::new()
     };
+    let not_followed: Vec<String> = not_followed_runs
+        .iter()
+        .map(|(id, ratio)| format!("{id} ({:.0} %)", 100.0 * ratio))
+        .collect();
     // Where those runs' departure lives: the variable their own rows' remaining equation error
     // varies with most (validate runs' rows too; a few runs give fewer rows than the campaign's
     // 12-bin view needs). An encoder counting 7 % under its header left one chaotic validate run
-    // unfollowed, its rows' error varying with θ (mod 2π) at F = 15 (p 4e-11) while the identify
-    // runs, swinging gently, showed nothing.
-    let not_followed_variable = (!not_followed.is_empty())
+    // unfollowed, its rows' error varying with θ (mod 2π) at F = 8.5 over 11 bins (p 8e-10)
+    // while the identify runs, swinging gently, showed nothing.
+    let not_followed_variable = (!not_followed_runs.is_empty())
         .then(|| {
-            let ids: Vec<&str> = not_followed
-                .iter()
-                .filter_map(|w| w.split(' ').next())
-                .collect();
             let rows_of: Vec<usize> = (0..view.weak.len())
-                .filter(|&i| ids.contains(&view.weak_runs[view.weak[i].run].0.as_str()))
+                .filter(|&i| {
+                    let id = view.weak_runs[view.weak[i].run].0.as_str();
+                    not_followed_runs.iter().any(|(r, _)| *r == id)
+                })
                 .collect();
             let bins = (rows_of.len() / 10).min(12);
             if bins < 3 {
