@@ -682,6 +682,39 @@ fn issue_14_finds_stribeck_and_tells_it_from_coulomb_constant() {
     assert!(!s.discovery.accepted().contains(&"coulomb_constant"));
 }
 
+/// The every-effect survey's first draws, `stribeck` k = 2: a 6.10e-3 N·m breakaway fading
+/// within v_s = 0.083 rad/s on a mixed design. The screen cannot see where it acts (the windows
+/// where the pendulum stops and sticks are left out) and profiled v_s at 0.51 rad/s; the refit
+/// from there went to T_s = 8.2e-5 N·m (−98.7 %), since near a size of 0 the speed scale does
+/// not move the trajectories at all. Started at the point of the shape's grid whose profile the
+/// trajectories follow best, it is refitted within 10 %. (It is still not named: its held-out
+/// E_θ fall, 11.5 % ± 6.5 %, is short of the second look's twice-the-bar, and the validate
+/// runs' equation error cannot see it either; the truth itself scores 12.1 % ± 6.6 % there.)
+#[test]
+fn a_breakaway_the_screen_puts_at_the_wrong_speed_is_refitted_at_the_one_the_trajectories_prefer() {
+    let truth = 6.101608974847369e-3;
+    let s = discover(
+        6202,
+        Base::Reference,
+        0.0,
+        0.5,
+        0.15,
+        &format!("stribeck = {{ t_s_nm = {truth}, v_s_rad_s = 0.08282869926321057 }}"),
+    );
+    let row = s.discovery.row("stribeck").expect("a stribeck row");
+    assert!(
+        (row.refit_estimate - truth).abs() <= 0.10 * truth,
+        "refit {:.4e} against {truth:.4e}: {}",
+        row.refit_estimate,
+        row.note
+    );
+    assert!(
+        !s.discovery.accepted().contains(&"coulomb_constant"),
+        "{:?}",
+        s.discovery.accepted()
+    );
+}
+
 /// Issue 15: a campaign recorded with a harvesting generator on the shaft (drawn load and dead
 /// band) names `generator_rectified` alone within 25 % of its c_g, and the extended model's
 /// refit carries both its load and its band.
