@@ -715,6 +715,33 @@ fn a_breakaway_the_screen_puts_at_the_wrong_speed_is_refitted_at_the_one_the_tra
     );
 }
 
+/// The every-effect survey's other draws (`SURVEY_SEED=1`), `coulomb_constant` k = 1: a
+/// 0.0130 N·m constant dry torque on a mixed design whose two moving identify runs share the
+/// 1.46 kg bob, so that their trajectories cannot tell T_c from μ·load: the refit went to
+/// T_c = 0.0010 with μ 0.23, the profile through the screen's 0.0126 fitted them as well, and so
+/// did the refit with T_c at 0. The validate runs' lighter bobs rejected the refit's model
+/// (held-out E_θ −70 %) and it was not named. With the trajectories silent, the model judged on
+/// the held-out runs carries the screen's value, and both held-out views confirm it.
+#[test]
+fn a_dry_torque_the_moving_runs_cannot_tell_from_bearing_friction_is_named_at_the_screens_value() {
+    let truth = 0.012982160473924685;
+    let s = discover(
+        105_401,
+        Base::Reference,
+        0.0,
+        0.5,
+        0.15,
+        &format!("coulomb_constant_t_c_nm = {truth}"),
+    );
+    assert_found(&s, "coulomb_constant", truth, 0.10, 0.0);
+    let row = s.discovery.row("coulomb_constant").unwrap();
+    assert!(
+        row.note.contains("carries the screen's value"),
+        "{}",
+        row.note
+    );
+}
+
 /// Issue 15: a campaign recorded with a harvesting generator on the shaft (drawn load and dead
 /// band) names `generator_rectified` alone within 25 % of its c_g, and the extended model's
 /// refit carries both its load and its band.
