@@ -718,6 +718,33 @@ fn a_breakaway_the_screen_puts_at_the_wrong_speed_is_refitted_at_the_one_the_tra
     );
 }
 
+/// The every-effect survey's other draws (`SURVEY_SEED=1`), `stribeck` k = 3: a 9.83e-3 N·m
+/// breakaway (v_s 0.24 rad/s) that the screen sized at 5.46e-3 at its profile's v_s 0.30, while
+/// the refit (v_s 0.25) said 9.96e-3. Only the refit's model is judged on the validate runs, and
+/// their equation error did not confirm the screen's size (a fall of 2.9 %, 5.0 % needed): the
+/// estimate named is the value the held-out runs confirmed, the refit's, within 10 %.
+#[test]
+fn a_breakaway_the_held_out_equation_error_does_not_confirm_is_named_at_its_refits_size() {
+    let truth = 9.829800115062686e-3;
+    let s = discover(
+        106_203,
+        Base::Reference,
+        0.0,
+        0.5,
+        0.15,
+        &format!("stribeck = {{ t_s_nm = {truth}, v_s_rad_s = 0.241348873181357 }}"),
+    );
+    assert_found(&s, "stribeck", truth, 0.10, 0.0);
+    let row = s.discovery.row("stribeck").unwrap();
+    assert!(
+        (row.screen_estimate - truth).abs() > 0.10 * truth
+            && row.note.contains("trajectory refit's"),
+        "screen {:.4e}: {}",
+        row.screen_estimate,
+        row.note
+    );
+}
+
 /// The every-effect survey's other draws (`SURVEY_SEED=1`), `coulomb_constant` k = 1: a
 /// 0.0130 N·m constant dry torque on a mixed design whose two moving identify runs share the
 /// 1.46 kg bob, so that their trajectories cannot tell T_c from μ·load: the refit went to
