@@ -11,7 +11,8 @@ use crate::capture::{
     accel_si, accel_step_plausible, check_rate, encoder_step_plausible, signed_step, theta_rad,
     value_glitch, AccelSample, Clock, Counter, EncoderSample, GapTracker, Header, IngestStats,
     Location, Lookahead, OrderRule, ReadOptions, Recent, Record, Sample, SegmentLog, Timeline,
-    TimelinePlan, CONFIRM_RECORDS, RATE_PROBE_RECORDS, TIMELINE_WINDOW,
+    TimelinePlan, CONFIRM_RECORDS, DEFAULT_ACCEL_HZ, DEFAULT_ACCEL_LSB_PER_G, DEFAULT_ENCODER_CPR,
+    DEFAULT_ENCODER_HZ, RATE_PROBE_RECORDS, TIMELINE_WINDOW,
 };
 use crate::crc8::crc8;
 use crate::error::RigError;
@@ -288,8 +289,20 @@ impl<R: Read> SdReader<R> {
         if avail < 2 || b[..2] != SYNC {
             return Err(self.not_a_capture(0, "expected the sd-v2 sync bytes A5 5A"));
         }
-        if avail < 4 || b[2] != FRAME_HEADER {
+        if avail < 4 {
             return Err(self.not_a_capture(2, "expected a header frame (type 3) first"));
+        }
+        if b[2] != FRAME_HEADER {
+            // A data frame first: no header was written (not damage the reader can repair).
+            if valid_kind_len(b[2], b[3]) {
+                return Err(self.not_a_capture(2, "expected a header frame (type 3) first"));
+            }
+            self.header_lost(
+                2,
+                "its type byte is neither a header's nor a data frame's",
+                None,
+            );
+            return Ok(());
         }
         let total = FRAME_OVERHEAD + usize::from(b[3]);
         if self.fill(total)? < total {
@@ -297,7 +310,9 @@ impl<R: Read> SdReader<R> {
         }
         let f = &self.buf[self.start..self.start + total];
         if crc8(&f[2..total - 1]) != f[total - 1] {
-            return Err(self.not_a_capture((total - 1) as u64, "header frame CRC mismatch"));
+            let text = String::from_utf8_lossy(&f[8..total - 1]).into_owned();
+            self.header_lost((total - 1) as u64, "CRC mismatch", Some(&text));
+            return Ok(());
         }
         let text = String::from_utf8_lossy(&f[8..total - 1]).into_owned();
         for line in text.lines() {
@@ -312,6 +327,41 @@ impl<R: Read> SdReader<R> {
         }
         self.start += total;
         Ok(())
+    }
+
+    /// A header frame that fails its checks. A bad card sector can corrupt bytes anywhere
+    /// (rig.md), the header's among them, and one flipped bit there must not cost the run: the
+    /// frame's keys cannot be trusted, so rig.md's defaults hold (as for a key absent from an
+    /// old capture; the rates are checked against the stamps as always, [`SdReader::probe_rate`]),
+    /// a warning says so, and the reader resynchronises from byte 0 on the next valid frame,
+    /// counting the header's bytes among those it dropped. Where the damaged frame still reads a
+    /// value other than the default for a key the reading depends on, the warning quotes it, for
+    /// the experimenter to check against the rig (the campaign's other captures say the same).
+    fn header_lost(&mut self, at: u64, why: &str, text: Option<&str>) {
+        let mut msg = format!(
+            "header frame damaged (byte {at}: {why}): its keys are not used and the defaults hold \
+             (encoder_cpr {DEFAULT_ENCODER_CPR}, accel_lsb_per_g {DEFAULT_ACCEL_LSB_PER_G}, \
+             encoder_hz {DEFAULT_ENCODER_HZ}, accel_hz {DEFAULT_ACCEL_HZ}; the rates are checked \
+             against the stamps)"
+        );
+        let defaults = [
+            ("encoder_cpr", f64::from(DEFAULT_ENCODER_CPR)),
+            ("accel_lsb_per_g", DEFAULT_ACCEL_LSB_PER_G),
+            ("encoder_hz", DEFAULT_ENCODER_HZ),
+            ("accel_hz", DEFAULT_ACCEL_HZ),
+        ];
+        for line in text.unwrap_or_default().lines() {
+            let Some((k, v)) = line.split_once('=') else {
+                continue;
+            };
+            let (k, v) = (k.trim(), v.trim());
+            if let Some((_, d)) = defaults.iter().find(|(key, _)| *key == k) {
+                if v.parse::<f64>().ok() != Some(*d) {
+                    msg.push_str(&format!("; the damaged frame reads {k}={v}: check it"));
+                }
+            }
+        }
+        self.stats.warn(msg);
     }
 
     /// Makes at least `k` bytes available if the file has them; returns how many are.
@@ -843,6 +893,52 @@ mod tests {
         assert_eq!(v.len(), 23);
         assert_eq!(st.truncated_tail_bytes, 11 - 4);
         assert_eq!(st.skipped_bytes, 0);
+    }
+
+    /// A bad card sector can corrupt bytes anywhere (rig.md), the header frame's among them: a
+    /// bit flipped in its text, its length or its type costs the header (the defaults hold, a
+    /// warning says so), never the run. A twin campaign's capture with one flipped bit at byte
+    /// 120 of its 150-byte header frame used to fail with "header frame CRC mismatch".
+    #[test]
+    fn a_damaged_header_frame_costs_its_keys_not_the_run() {
+        let clean = capture();
+        let header_len = FRAME_OVERHEAD + usize::from(clean[3]);
+        for (at, bit) in [(12, 0), (header_len - 3, 5), (3, 0), (2, 2)] {
+            let mut bytes = clean.clone();
+            bytes[at] ^= 1 << bit;
+            let (v, st) = read_all(&bytes);
+            assert_eq!(v.len(), 24, "byte {at}: every data frame is kept");
+            assert!(
+                st.warnings
+                    .iter()
+                    .any(|w| w.contains("header frame damaged")),
+                "byte {at}: {:?}",
+                st.warnings
+            );
+            assert!(
+                st.skipped_bytes >= header_len as u64 - 1,
+                "byte {at}: the header's bytes are counted as dropped ({})",
+                st.skipped_bytes
+            );
+        }
+    }
+
+    /// The warning quotes a key the reading depends on whose damaged value is not the default.
+    #[test]
+    fn a_damaged_header_that_reads_another_resolution_says_so() {
+        let mut w =
+            SdWriter::new(Vec::new(), &Header::sd_v2().with("encoder_cpr", "2048")).unwrap();
+        w.write_encoder(0, 0).unwrap();
+        w.write_encoder(1000, 1).unwrap();
+        let mut bytes = w.finish().unwrap();
+        let text_end = FRAME_OVERHEAD + usize::from(bytes[3]) - 1;
+        bytes[text_end - 1] ^= 1;
+        let (_, st) = read_all(&bytes);
+        assert!(
+            st.warnings.iter().any(|w| w.contains("encoder_cpr=2048")),
+            "{:?}",
+            st.warnings
+        );
     }
 
     #[test]

@@ -951,7 +951,10 @@ fn synthesize_run(
                 }
                 w.finish().map_err(io)?;
             }
-            // A bad card sector: flip bytes at a few random spots past the header.
+            // A bad card sector: flip bits at a few random spots past the first 64 bytes (so
+            // the sync and type bytes that mark the file as a capture stay readable); the
+            // header frame's text and CRC are among the spots, as rig.md allows ("corrupt bytes
+            // anywhere"): the reader must keep the run.
             let spots = (s.sd_corruptions_per_mb * buf.len() as f64 / 1e6).round() as usize;
             for _ in 0..spots {
                 let p = rng.random_range(64..buf.len().max(65));
