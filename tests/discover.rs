@@ -718,6 +718,26 @@ fn a_breakaway_the_screen_puts_at_the_wrong_speed_is_refitted_at_the_one_the_tra
     );
 }
 
+/// The every-effect survey's other draws (`SURVEY_SEED=1`), `horizontal_base` k = 4: a
+/// −0.0787 rad tilt on a mixed design. The screen met the tilt before the runs' common zeroing
+/// error (a few counts, the rig's own), whose column (1 + A_y) cos θ shares the tilt's A_y cos θ:
+/// left out, it put the tilt at −0.0800 (+1.7 %) and its cos θ part was named a 1.4e-3 N·m k = 1
+/// position torque beside it (held-out E_θ −6.3 %). With the zeroing error held as a nuisance
+/// before any effect is judged, the tilt is named alone.
+#[test]
+fn a_tilt_met_before_the_runs_zeroing_error_is_named_alone() {
+    let truth = -0.07866408049218221;
+    let s = discover(
+        105_604,
+        Base::Reference,
+        0.0,
+        0.5,
+        0.15,
+        &format!("horizontal_base_delta_rad = {truth}"),
+    );
+    assert_found(&s, "horizontal_base", truth, 0.10, 0.0);
+}
+
 /// The every-effect survey's other draws (`SURVEY_SEED=1`), `stribeck` k = 3: a 9.83e-3 N·m
 /// breakaway (v_s 0.24 rad/s) that the screen sized at 5.46e-3 at its profile's v_s 0.30, while
 /// the refit (v_s 0.25) said 9.96e-3. Only the refit's model is judged on the validate runs, and

@@ -567,6 +567,19 @@ pub fn stepwise_from(
             first_round = ranked.clone();
             first = false;
         }
+        // The rig's own zeroing error first: where the encoder offset would enter (past the
+        // threshold) at a size within its tolerance, it is held as a nuisance before any effect
+        // is judged, whichever candidate leads the round.
+        if let Some(z) = ranked
+            .iter()
+            .find(|r| is_nuisance(r) && r.delta_bic < threshold)
+        {
+            current = with_candidate(&current, &z.candidate);
+            let name = z.candidate.effect.clone();
+            pool.retain(|c| c.effect != name);
+            nuisance.extend(z.candidate.add.iter().copied());
+            continue;
+        }
         let Some(best) = parsimonious(&ranked) else {
             break;
         };
