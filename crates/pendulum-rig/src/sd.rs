@@ -336,7 +336,7 @@ impl<R: Read> SdReader<R> {
     /// a warning says so, and the reader resynchronises from byte 0 on the next valid frame,
     /// counting the header's bytes among those it dropped. Where the damaged frame still reads a
     /// value other than the default for a key the reading depends on, the warning quotes it, for
-    /// the experimenter to check against the rig (the campaign's other captures say the same).
+    /// the experimenter to check against the rig.
     fn header_lost(&mut self, at: u64, why: &str, text: Option<&str>) {
         let mut msg = format!(
             "header frame damaged (byte {at}: {why}): its keys are not used and the defaults hold \
@@ -897,8 +897,9 @@ mod tests {
 
     /// A bad card sector can corrupt bytes anywhere (rig.md), the header frame's among them: a
     /// bit flipped in its text, its length or its type costs the header (the defaults hold, a
-    /// warning says so), never the run. A twin campaign's capture with one flipped bit at byte
-    /// 120 of its 150-byte header frame used to fail with "header frame CRC mismatch".
+    /// warning says so), never the run. A twin campaign's capture with one flipped bit in its
+    /// 150-byte header frame (its `accel_hz=200` read 208) used to fail with "header frame CRC
+    /// mismatch".
     #[test]
     fn a_damaged_header_frame_costs_its_keys_not_the_run() {
         let clean = capture();
