@@ -371,7 +371,21 @@ impl IngestStats {
     ///
     /// The same rule for both rig readers; the fractions are skipped when a reader does not
     /// count bytes or knows no rate.
+    /// The reasons carry the reader's warnings, which often say why so little was kept (a
+    /// damaged header frame, a rate the stamps contradict).
     pub fn failure(&self) -> Option<String> {
+        let why = self.failure_reason()?;
+        Some(if self.warnings.is_empty() {
+            why
+        } else {
+            format!(
+                "{why} (the reader also warned: {})",
+                self.warnings.join("; ")
+            )
+        })
+    }
+
+    fn failure_reason(&self) -> Option<String> {
         if self.encoder_samples < 2 {
             return Some(format!(
                 "kept {} encoder samples: nothing left to analyse ({} lines/frames, {} bytes skipped as damaged)",
