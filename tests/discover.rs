@@ -718,6 +718,17 @@ fn a_breakaway_the_screen_puts_at_the_wrong_speed_is_refitted_at_the_one_the_tra
     );
 }
 
+/// The every-effect survey's third draws (`SURVEY_SEED=2`), `viscous_quadratic` k = 2: a burst
+/// of lost encoder samples at run r01's shaker start left its initial-state window with one
+/// sample, and that error failed the whole campaign. The run is now left out with a note and the
+/// drag is named from the other seven.
+#[test]
+fn a_run_whose_initial_state_a_gap_hides_is_left_out_not_the_campaign() {
+    let truth = 0.1344138646497388;
+    let s = discover(205_102, Base::Linear, truth, 0.3, 0.0, "");
+    assert_found(&s, "viscous_quadratic", truth, 0.10, 0.0);
+}
+
 /// The every-effect survey's other draws (`SURVEY_SEED=1`), `horizontal_base` k = 4: a
 /// −0.0787 rad tilt on a mixed design. The screen met the tilt before the runs' common zeroing
 /// error (a few counts, the rig's own), whose column (1 + A_y) cos θ shares the tilt's A_y cos θ:

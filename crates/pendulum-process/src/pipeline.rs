@@ -235,9 +235,21 @@ impl Stage for IcStage {
         "initial_conditions"
     }
     fn run(&self, ctx: &mut Context) -> Result<(), ProcessError> {
+        // A run whose state at t0 cannot be estimated (a burst of lost samples there leaves the
+        // window nearly empty) is left out of the analysis with a note, not the campaign's
+        // failure: a drawn twin campaign stopped on "only 1 encoder samples within ±0.06 s".
+        // (Every run left out is still an error: there is nothing to analyse.)
+        let mut left_out = Vec::new();
         for run in &ctx.runs {
             let al = ctx.require(&ctx.alignments, &run.id, "the alignment", self.name())?;
-            let ic = estimate_state(run, al.t0_s, &self.0)?;
+            let ic = match estimate_state(run, al.t0_s, &self.0) {
+                Ok(ic) => ic,
+                Err(e @ ProcessError::Run { .. }) if ctx.runs.len() > 1 => {
+                    left_out.push((run.id.clone(), e));
+                    continue;
+                }
+                Err(e) => return Err(e),
+            };
             let hang = hanging_position(run, al.free_segment_s.0, al.free_segment_s.1);
             if let Some(h) = hang {
                 // A zero more than ~6 counts off the hanging position is worth saying.
@@ -250,6 +262,16 @@ impl Stage for IcStage {
             }
             ctx.initial.insert(run.id.clone(), ic);
             ctx.hanging.insert(run.id.clone(), hang);
+        }
+        if left_out.len() == ctx.runs.len() {
+            let (_, first) = left_out.swap_remove(0);
+            return Err(first);
+        }
+        for (id, why) in left_out {
+            ctx.runs.retain(|r| r.id != id);
+            ctx.notes.push(format!(
+                "run {id} is left out of the analysis: its initial state cannot be estimated ({why})"
+            ));
         }
         Ok(())
     }
