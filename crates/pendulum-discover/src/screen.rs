@@ -569,30 +569,22 @@ pub fn stepwise_from(
         }
         // The rig's own zeroing error first: where the encoder offset would enter (past the
         // threshold) at a size within its tolerance, it is held as a nuisance before any effect
-        // is judged, whichever candidate leads the round.
-        if let Some(z) = ranked
+        // is judged, whichever candidate leads the round; otherwise the round's most
+        // parsimonious best, if it enters.
+        let entering = ranked
             .iter()
             .find(|r| is_nuisance(r) && r.delta_bic < threshold)
-        {
-            current = with_candidate(&current, &z.candidate);
-            let name = z.candidate.effect.clone();
-            pool.retain(|c| c.effect != name);
-            nuisance.extend(z.candidate.add.iter().copied());
-            continue;
-        }
-        let Some(best) = parsimonious(&ranked) else {
+            .or_else(|| parsimonious(&ranked).filter(|b| b.delta_bic < threshold));
+        let Some(next) = entering else {
             break;
         };
-        if best.delta_bic >= threshold {
-            break;
-        }
-        current = with_candidate(&current, &best.candidate);
-        let name = best.candidate.effect.clone();
+        current = with_candidate(&current, &next.candidate);
+        let name = next.candidate.effect.clone();
         pool.retain(|c| c.effect != name);
-        if is_nuisance(best) {
-            nuisance.extend(best.candidate.add.iter().copied());
+        if is_nuisance(next) {
+            nuisance.extend(next.candidate.add.iter().copied());
         } else {
-            chosen.push(best.clone());
+            chosen.push(next.clone());
         }
     }
     Stepwise {

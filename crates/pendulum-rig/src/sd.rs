@@ -11,8 +11,7 @@ use crate::capture::{
     accel_si, accel_step_plausible, check_rate, encoder_step_plausible, signed_step, theta_rad,
     value_glitch, AccelSample, Clock, Counter, EncoderSample, GapTracker, Header, IngestStats,
     Location, Lookahead, OrderRule, ReadOptions, Recent, Record, Sample, SegmentLog, Timeline,
-    TimelinePlan, CONFIRM_RECORDS, DEFAULT_ACCEL_HZ, DEFAULT_ACCEL_LSB_PER_G, DEFAULT_ENCODER_CPR,
-    DEFAULT_ENCODER_HZ, RATE_PROBE_RECORDS, TIMELINE_WINDOW,
+    TimelinePlan, CONFIRM_RECORDS, RATE_PROBE_RECORDS, TIMELINE_WINDOW,
 };
 use crate::crc8::crc8;
 use crate::error::RigError;
@@ -338,18 +337,20 @@ impl<R: Read> SdReader<R> {
     /// value other than the default for a key the reading depends on, the warning quotes it, for
     /// the experimenter to check against the rig.
     fn header_lost(&mut self, at: u64, why: &str, text: Option<&str>) {
+        // The values an empty header falls back to: `Header`'s own accessors, the one source.
+        let empty = Header::new();
+        let defaults = [
+            ("encoder_cpr", f64::from(empty.encoder_cpr())),
+            ("accel_lsb_per_g", empty.accel_lsb_per_g()),
+            ("encoder_hz", empty.encoder_hz()),
+            ("accel_hz", empty.accel_hz()),
+        ];
+        let listed: Vec<String> = defaults.iter().map(|(k, v)| format!("{k} {v}")).collect();
         let mut msg = format!(
             "header frame damaged (byte {at}: {why}): its keys are not used and the defaults hold \
-             (encoder_cpr {DEFAULT_ENCODER_CPR}, accel_lsb_per_g {DEFAULT_ACCEL_LSB_PER_G}, \
-             encoder_hz {DEFAULT_ENCODER_HZ}, accel_hz {DEFAULT_ACCEL_HZ}; the rates are checked \
-             against the stamps)"
+             ({}; the rates are checked against the stamps)",
+            listed.join(", ")
         );
-        let defaults = [
-            ("encoder_cpr", f64::from(DEFAULT_ENCODER_CPR)),
-            ("accel_lsb_per_g", DEFAULT_ACCEL_LSB_PER_G),
-            ("encoder_hz", DEFAULT_ENCODER_HZ),
-            ("accel_hz", DEFAULT_ACCEL_HZ),
-        ];
         for line in text.unwrap_or_default().lines() {
             let Some((k, v)) = line.split_once('=') else {
                 continue;
