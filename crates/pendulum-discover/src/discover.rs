@@ -8,11 +8,11 @@
 //!    trajectory error E_θ (initial states refitted for each model) falls by more than
 //!    max(`gain_min`, the held-out noise), or their equation error (coefficients from the
 //!    identify runs) falls by more than max(`eq_gain_min`, its held-out noise) while E_θ does not
-//!    rise by more than its noise. The noise of a fall is 1.96 × its standard error over paired
-//!    units (the ratio estimator's: each unit's departure from the common fall): the 0.5 s
-//!    multiple-shooting segments of the validate runs for E_θ (each restarts from the measured
-//!    state), the weak-form windows for the equation error. A fall that the units' own scatter
-//!    could produce by chance (one-sided 2.5 %) is not a gain. (Sensor
+//!    rise by more than its noise. The noise of a fall is 1.96 × its standard error from the
+//!    paired differences of its units: the 0.5 s multiple-shooting segments of the validate runs
+//!    for E_θ (each restarts from the measured state), the weak-form windows for the equation
+//!    error. A fall that the units' own scatter could produce by chance (one-sided 2.5 %) is not
+//!    a gain. (Sensor
 //!    effects such as an accelerometer lag move E_θ on 0.5 s segments very little but the
 //!    equation error a lot.) A second effect, added to a model already extended, is judged the
 //!    same way against that model.
@@ -98,8 +98,8 @@ pub struct DiagnosisRow {
     pub delta_bic: f64,
     /// Fractional fall of validate-run E_θ (NaN when not refitted).
     pub heldout_gain: f64,
-    /// 1.96 × the standard error of `heldout_gain` over the paired segments (the ratio
-    /// estimator's; NaN when not refitted).
+    /// 1.96 × the standard error of `heldout_gain` from the paired per-segment differences
+    /// (NaN when not refitted).
     pub heldout_noise: f64,
     /// Fractional fall of the validate runs' weighted squared equation error (coefficients from
     /// the identify runs, each validate run's zeroing error refitted; NaN when not refitted).
