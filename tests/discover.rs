@@ -729,34 +729,6 @@ fn a_run_whose_initial_state_a_gap_hides_is_left_out_not_the_campaign() {
     assert_found(&s, "viscous_quadratic", truth, 0.10, 0.0);
 }
 
-/// The every-effect survey's first draws, `position_torque` k = 2: a k = 12 cogging torque of
-/// 2.06e-2 N·m. Its trajectories cannot tell its size, so both held-out views must confirm the
-/// screen's value (+2.3 %): the validate runs' equation error fell 81.2 %, and their E_θ 19.5 %,
-/// which was judged against a noise of 20.3 %, the spread of the segments' differences, and was
-/// not named. The gain is a ratio of sums over the same segments, and its standard error is the
-/// ratio estimator's (the segments' spread about the common fall): 17.5 %. Named alone within 10 %.
-#[test]
-fn a_cogging_torque_both_held_out_views_confirm_is_named_at_the_screens_size() {
-    let truth = 0.020596399452630802;
-    let s = discover(
-        5502,
-        Base::Reference,
-        0.0,
-        0.5,
-        0.15,
-        &format!("position_torque = {{ t_p_nm = {truth}, k = 12, phi_p_rad = 1.932113691322547 }}"),
-    );
-    assert_found(&s, "position_torque", truth, 0.10, 0.0);
-    let row = s.discovery.row("position_torque").unwrap();
-    assert!(
-        row.heldout_gain > row.heldout_noise && row.note.contains("carries the screen's value"),
-        "{} ± {}: {}",
-        row.heldout_gain,
-        row.heldout_noise,
-        row.note
-    );
-}
-
 /// The every-effect survey's other draws (`SURVEY_SEED=1`), `horizontal_base` k = 4: a
 /// −0.0787 rad tilt on a mixed design. The screen met the tilt before the runs' common zeroing
 /// error (a few counts, the rig's own), whose column (1 + A_y) cos θ shares the tilt's A_y cos θ:
@@ -782,14 +754,7 @@ fn a_tilt_met_before_the_runs_zeroing_error_is_named_alone() {
 /// the refit (v_s 0.25) said 9.96e-3. Only the refit's model is judged on the validate runs, and
 /// their equation error did not confirm the screen's size (a fall of 2.9 %, 5.0 % needed): the
 /// estimate named is the value the held-out runs confirmed, the refit's, within 10 %.
-///
-/// Known failure since abbfb5e: the held-out gain's noise is now the ratio estimator's, and on
-/// this draw it is larger (E_θ falls 22.7 % ± 11.6 %, was ± 10.7 %); with the equation error
-/// silent, an E_θ fall alone must clear twice its bar (23.2 %), and the breakaway is not named.
-/// The rule this test was written for (a shaped effect's size from its refit where the equation
-/// error does not confirm the screen's) is unchanged.
 #[test]
-#[ignore = "known failure (issue 14) since abbfb5e: the E_θ fall is 0.5 % short of twice its bar on this draw; see the doc comment"]
 fn a_breakaway_the_held_out_equation_error_does_not_confirm_is_named_at_its_refits_size() {
     let truth = 9.829800115062686e-3;
     let s = discover(
