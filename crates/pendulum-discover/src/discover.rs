@@ -1399,6 +1399,18 @@ const HELDOUT_Z: f64 = 1.96;
 /// A paired held-out comparison: the fractional fall 1 − Σafter/Σbefore over paired units, and
 /// the noise it must beat, z × its standard error from the spread of the paired differences
 /// (infinite with fewer than three units: nothing can be told apart then).
+///
+/// The spread of the differences is the fall's scatter under the null (no change: each unit's
+/// difference is as likely either way), which is what "a fall the units' own scatter could
+/// produce by chance" asks. It is not the sampling error of the fall itself: that is the ratio
+/// estimator's (the spread of d − g·before, which the bootstrap over units reproduces), far
+/// smaller where every unit falls in proportion (a k = 49 cogging torque's 98.3 % equation-error
+/// fall was judged against 116 %). Tried in abbfb5e and undone: the bars that use this noise for
+/// a rise too ("E_θ may not rise by more than its noise") then vetoed effects the equation error
+/// confirmed wherever the validate runs rest (E_θ 0.019 → 0.033 rad on runs at rest became a
+/// significant −74 % ± 1.7 %), and the surveys lost as many campaigns as they gained (first
+/// draws +1, other draws −1, third draws −2, one departure's `unexplained`). Changing it means
+/// giving those bars their own null noise and a floor for runs at rest.
 pub(crate) fn paired_gain(before: &[f64], after: &[f64]) -> (f64, f64) {
     let n = before.len().min(after.len());
     let sb: f64 = before[..n].iter().sum();
