@@ -1408,9 +1408,9 @@ const HELDOUT_Z: f64 = 1.96;
 /// fall was judged against 116 %). Tried in abbfb5e and undone: the bars that use this noise for
 /// a rise too ("E_θ may not rise by more than its noise") then vetoed effects the equation error
 /// confirmed wherever the validate runs rest (E_θ 0.019 → 0.033 rad on runs at rest became a
-/// significant −74 % ± 1.7 %), and the surveys lost as many campaigns as they gained (first
-/// draws +1, other draws −1, third draws −2, one departure's `unexplained`). Changing it means
-/// giving those bars their own null noise and a floor for runs at rest.
+/// significant −74 % ± 1.7 %), and the surveys lost more campaigns than they gained (first
+/// draws +1, other draws −1, third draws −2 in their first 25, one departure's `unexplained`).
+/// Changing it means giving those bars their own null noise and a floor for runs at rest.
 pub(crate) fn paired_gain(before: &[f64], after: &[f64]) -> (f64, f64) {
     let n = before.len().min(after.len());
     let sb: f64 = before[..n].iter().sum();
