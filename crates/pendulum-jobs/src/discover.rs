@@ -233,7 +233,14 @@ fn run_unmarked(job: &DiscoverJob) -> Result<DiscoverSummary, JobError> {
         b.finish_and_clear();
     }
     res?;
-    let d = discover(&ctx, job.base, &pipe.discover)?;
+    let free = identify_free_segments(&ctx, &stages, &pipe.discover);
+    if !free.is_empty() {
+        ctx.notes.push(format!(
+            "the trajectory refits also follow the free segment before the shaker starts of {} identify run(s) (those that move)",
+            free.len()
+        ));
+    }
+    let d = discover(&ctx, job.base, &pipe.discover, &free)?;
 
     // Tables shared with identify: params/residuals/... for the base and the extended model.
     ctx.validations
@@ -1296,4 +1303,62 @@ fn write_report(
         path: path.to_path_buf(),
         source,
     })
+}
+
+/// The identify runs' free segments before their shakers start (at least
+/// [`crate::identify::FREE_SEGMENT_MIN_S`]), aligned, started and prepared as free decays by the
+/// pipeline's own stages (not its fit), then as runs of the shaker model with the crank still
+/// ([`pendulum_process::fit::PreparedRun::unforced`]): discover's trajectory refits see the
+/// damping over the run's widest swings. A segment a stage cannot handle is left out.
+fn identify_free_segments(
+    ctx: &Context,
+    stages: &PipelineConfig,
+    cfg: &DiscoverConfig,
+) -> Vec<pendulum_process::fit::PreparedRun> {
+    let runs: Vec<_> = crate::identify::free_segment_runs(ctx)
+        .into_iter()
+        .filter(|r| r.role == Role::Identify)
+        .collect();
+    if runs.is_empty() {
+        return Vec::new();
+    }
+    let pre = PipelineConfig {
+        name: stages.name.clone(),
+        stages: stages
+            .stages
+            .iter()
+            .filter(|s| !matches!(s, StageConfig::Fit(_) | StageConfig::Validate(_)))
+            .cloned()
+            .collect(),
+    };
+    let mut fctx = Context::new(runs);
+    if pre.run(&mut fctx).is_err() {
+        return Vec::new();
+    }
+    let mut out = Vec::new();
+    for run in &fctx.runs {
+        let parent = run.id.trim_end_matches("-free");
+        let Some(omega_hz) = ctx.alignments.get(parent).map(|a| a.omega_hz) else {
+            continue;
+        };
+        let (Some(al), Some(ic), Some(st)) = (
+            fctx.alignments.get(&run.id),
+            fctx.initial.get(&run.id),
+            fctx.steady.get(&run.id),
+        ) else {
+            continue;
+        };
+        let Ok(p) = pendulum_process::identify::prepare_run(
+            run,
+            al,
+            ic,
+            st,
+            &fctx.steady_cfg,
+            &cfg.validate.window,
+        ) else {
+            continue;
+        };
+        out.extend(p.unforced(omega_hz));
+    }
+    out
 }

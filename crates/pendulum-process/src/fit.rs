@@ -524,6 +524,31 @@ pub struct PreparedRun {
 }
 
 impl PreparedRun {
+    /// This free decay (the free segment before a shaker starts, prepared as a decay) as a run
+    /// of the shaker model with the crank still: crank radius 0, the crank's speed `omega_hz`
+    /// kept only for the time unit's sake, and a shaker run's time unit sqrt(g/l). An SI model
+    /// then simulates it with every term it holds (a free-decay model knows only the
+    /// identifiable ratios of a, b, μ and a dry torque). `None` for a run that is not a free
+    /// decay.
+    pub fn unforced(&self, omega_hz: f64) -> Option<PreparedRun> {
+        if !self.free || !(omega_hz > 0.0) {
+            return None;
+        }
+        let w = self.rig.omega0_rad_s();
+        let s = w / self.omega0_rad_s;
+        let mut r = self.clone();
+        r.t.iter_mut().for_each(|t| *t *= s);
+        r.tail_t.iter_mut().for_each(|t| *t *= s);
+        r.restarts.iter_mut().for_each(|(_, y)| y[1] /= s);
+        r.ic_est[1] /= s;
+        r.rig.crank_r_m = 0.0;
+        r.rig.omega_hz = Some(omega_hz);
+        r.omega_hz = omega_hz;
+        r.free = false;
+        r.omega0_rad_s = w;
+        Some(r)
+    }
+
     /// ω0 of the run, rad/s.
     pub fn omega0(&self) -> f64 {
         self.omega0_rad_s
@@ -1506,6 +1531,76 @@ mod tests {
                 rest_tol: 0.01,
             },
         }
+    }
+
+    /// The free segment before a shaker starts, prepared as a free decay (in its period-derived
+    /// time unit, 7 % off sqrt(g/l) here), and converted by [`PreparedRun::unforced`]: the SI
+    /// model that swung it (crank still) follows it as it follows a forced run of its own, its
+    /// times and rates are the shaker's units again, and a forced run is not converted.
+    #[test]
+    fn an_unforced_free_segment_is_followed_by_the_model_that_swung_it() {
+        // `run` forces its truth; the measurement again, with the crank still.
+        let mut swung = run(1.75, STUDY, [1.2, 0.0]);
+        swung.rig.crank_r_m = 0.0;
+        let w0 = swung.rig.omega0_rad_s();
+        let model = Model::new(
+            ModelSpec::reference()
+                .physical(&swung.rig, 1.75, &STUDY)
+                .to_dimensionless(),
+        );
+        let (mut theta, mut state) = (Vec::new(), Vec::new());
+        integrate(
+            &model,
+            &SimOptions::with_tol(1e-10),
+            0.0,
+            [1.2, 0.0],
+            swung.t[swung.t.len() - 1],
+            swung.t.iter().copied(),
+            |s| {
+                theta.push(s.theta);
+                state.push([s.theta, s.theta_dot]);
+                ControlFlow::Continue(())
+            },
+        )
+        .unwrap();
+        let w_est = 1.07 * w0;
+        let s = w_est / w0;
+        let mut decay = swung.clone();
+        decay.rig.crank_r_m = 0.0725;
+        decay.rig.omega_hz = None;
+        decay.omega_hz = f64::NAN;
+        decay.free = true;
+        decay.omega0_rad_s = w_est;
+        decay.t = swung.t.iter().map(|t| t * s).collect();
+        decay.theta = theta;
+        decay.restarts = (1..10)
+            .map(|k| (50 * k, [state[50 * k][0], state[50 * k][1] / s]))
+            .collect();
+        decay.ic_est = [1.2, 0.0];
+        assert!(
+            swung.unforced(1.75).is_none(),
+            "a forced run is not a free decay"
+        );
+        let r = decay.unforced(1.75).expect("a free decay");
+        assert!(!r.free && r.rig.crank_r_m == 0.0 && r.omega_hz == 1.75);
+        for (a, b) in r.t.iter().zip(&swung.t) {
+            assert!((a - b).abs() < 1e-9 * b.max(1.0), "{a} against {b}");
+        }
+        let spec = ModelSpec::reference();
+        let e = |p: [f64; 3]| {
+            let objective = plain_objective(std::slice::from_ref(&r), &spec);
+            let mut x = p.to_vec();
+            x.extend_from_slice(&r.ic_est);
+            objective.evaluate(&x).per_run_e[0]
+        };
+        let truth = e(STUDY);
+        let ratio = crate::identify::misfit_ratio(&r, truth).expect("a moving run");
+        assert!(ratio < 0.01, "the truth misses {ratio}");
+        let doubled = e([STUDY[0], 2.0 * STUDY[1], STUDY[2]]);
+        assert!(
+            doubled > 10.0 * truth,
+            "b doubled {doubled} against the truth {truth}"
+        );
     }
 
     /// Parameter sets and starts with robust classes: stuck at rest, oscillation, rotation.
