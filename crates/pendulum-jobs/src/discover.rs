@@ -1337,8 +1337,14 @@ fn identify_free_segments(
     }
     let mut out = Vec::new();
     for run in &fctx.runs {
-        let parent = run.id.trim_end_matches("-free");
-        let Some(omega_hz) = ctx.alignments.get(parent).map(|a| a.omega_hz) else {
+        // One "-free" (`free_segment_runs`' suffix): a run the user named "warm-free" is
+        // "warm-free-free" here.
+        let Some(omega_hz) = run
+            .id
+            .strip_suffix("-free")
+            .and_then(|parent| ctx.alignments.get(parent))
+            .map(|a| a.omega_hz)
+        else {
             continue;
         };
         let (Some(al), Some(ic), Some(st)) = (
