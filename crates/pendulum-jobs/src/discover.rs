@@ -233,10 +233,18 @@ fn run_unmarked(job: &DiscoverJob) -> Result<DiscoverSummary, JobError> {
         b.finish_and_clear();
     }
     res?;
-    let free = identify_free_segments(&ctx, &stages, &pipe.discover);
+    let free = match identify_free_segments(&ctx, &stages, &pipe.discover) {
+        Ok(free) => free,
+        Err(e) => {
+            ctx.notes.push(format!(
+                "the identify runs' free segments before the shakers start could not be prepared ({e}): the trajectory refits follow the forced windows only"
+            ));
+            Vec::new()
+        }
+    };
     if !free.is_empty() {
         ctx.notes.push(format!(
-            "the trajectory refits also follow the free segment before the shaker starts of {} identify run(s) (those that move)",
+            "the trajectory refits also follow the free segment before the shaker starts of {} identify run(s) (one at rest adds nothing)",
             free.len()
         ));
     }
@@ -1309,18 +1317,19 @@ fn write_report(
 /// [`crate::identify::FREE_SEGMENT_MIN_S`]), aligned, started and prepared as free decays by the
 /// pipeline's own stages (not its fit), then as runs of the shaker model with the crank still
 /// ([`pendulum_process::fit::PreparedRun::unforced`]): discover's trajectory refits see the
-/// damping over the run's widest swings. A segment a stage cannot handle is left out.
+/// damping over the run's widest swings. A segment whose initial state or preparation fails is
+/// left out; a stage that fails the whole set is the error.
 fn identify_free_segments(
     ctx: &Context,
     stages: &PipelineConfig,
     cfg: &DiscoverConfig,
-) -> Vec<pendulum_process::fit::PreparedRun> {
+) -> Result<Vec<pendulum_process::fit::PreparedRun>, pendulum_process::ProcessError> {
     let runs: Vec<_> = crate::identify::free_segment_runs(ctx)
         .into_iter()
         .filter(|r| r.role == Role::Identify)
         .collect();
     if runs.is_empty() {
-        return Vec::new();
+        return Ok(Vec::new());
     }
     let pre = PipelineConfig {
         name: stages.name.clone(),
@@ -1332,9 +1341,7 @@ fn identify_free_segments(
             .collect(),
     };
     let mut fctx = Context::new(runs);
-    if pre.run(&mut fctx).is_err() {
-        return Vec::new();
-    }
+    pre.run(&mut fctx)?;
     let mut out = Vec::new();
     for run in &fctx.runs {
         // One "-free" (`free_segment_runs`' suffix): a run the user named "warm-free" is
@@ -1366,5 +1373,5 @@ fn identify_free_segments(
         };
         out.extend(p.unforced(omega_hz));
     }
-    out
+    Ok(out)
 }
