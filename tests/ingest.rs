@@ -537,6 +537,47 @@ fn ideal_runs() -> String {
     .concat()
 }
 
+/// A noiseless accelerometer (the twin's ideal sensors) reads one level while the shaker is off,
+/// so its measured noise is 0; the crank-rod model fits its forced samples to their quantisation.
+/// The forcing must count as understood: the noise it is judged against is never below the
+/// quantisation's (step/√12). Before that floor every run of an ideal-sensor campaign was
+/// flagged "forcing not understood" with residual and noise both printed as 0.000 m/s², and its
+/// forced segments left out of discover's equation error.
+#[test]
+fn a_noiseless_accelerometers_forcing_is_understood() {
+    let dir = tempfile::tempdir().unwrap();
+    let camp = dir.path().join("campaign");
+    let case = twin_case(3, &ideal_runs(), SensorModel::ideal());
+    synth(&case, &camp);
+    let runs = pendulum_jobs::runs::load_runs(&camp).expect("the campaign loads");
+    assert_eq!(runs.len(), 4);
+    for run in &runs {
+        // The twin writes 8192 LSB per g (rig.md's header default).
+        let lsb_m_s2 = run.rig.g_m_s2 / 8192.0;
+        let al = pendulum_process::align::align(run, &Default::default()).expect("aligns");
+        assert!(
+            al.forcing_residual_rms_m_s2.is_finite(),
+            "{}: the crank phase was tracked",
+            run.id
+        );
+        // The floor is the quantisation's, not more: a noise inflated past it would hide a
+        // forcing the model does not fit.
+        assert!(
+            (al.accel_noise_m_s2 - lsb_m_s2 / 12f64.sqrt()).abs() < 0.05 * lsb_m_s2,
+            "{}: noise {} m/s², LSB {lsb_m_s2} m/s²",
+            run.id,
+            al.accel_noise_m_s2
+        );
+        assert!(
+            al.forcing_understood(),
+            "{}: residual {} m/s² against noise {} m/s²",
+            run.id,
+            al.forcing_residual_rms_m_s2,
+            al.accel_noise_m_s2
+        );
+    }
+}
+
 /// How long after the truth's t = 0 the re-simulated θ is compared with the encoder.
 const FORCED_CHECK_S: f64 = 4.0;
 
