@@ -758,6 +758,42 @@ fn a_generator_whose_forced_identify_runs_all_rest_is_refitted_on_their_free_seg
     );
 }
 
+/// The every-effect survey's third draws (`SURVEY_SEED=2`), `position_torque` k = 0: a k = 4
+/// torque of 0.0397 N·m. It was accepted (refit 0.0382 N·m), and the re-screen of what was left
+/// then offered the same effect again at k = 63 (ΔBIC −10.4), which was refused; its row replaced
+/// the accepted one, so the report named nothing while the extended model held the k = 4 torque.
+/// An effect the model already holds is not screened again.
+#[test]
+fn an_accepted_effect_is_not_judged_again_by_a_later_round() {
+    let truth = 0.03972711929067914;
+    let s = discover(
+        205_500,
+        Base::Reference,
+        0.0,
+        0.5,
+        0.15,
+        &format!("position_torque = {{ t_p_nm = {truth}, k = 4, phi_p_rad = 1.7715398519723493 }}"),
+    );
+    for r in &s.discovery.rows {
+        eprintln!("note {}: {}", r.effect, r.note);
+    }
+    assert_eq!(s.discovery.accepted(), vec!["position_torque"]);
+    let row = s.discovery.row("position_torque").unwrap();
+    assert!(row.note.starts_with("k = 4;"), "{}", row.note);
+    assert!(
+        (row.estimate / truth - 1.0).abs() <= 0.10,
+        "{}",
+        row.estimate
+    );
+    // The report's row and the extended model agree: the model holds what the row names.
+    let ext = s.discovery.extended.as_ref().expect("an extended model");
+    assert!(
+        ext.spec.name.ends_with("+position_torque"),
+        "{}",
+        ext.spec.name
+    );
+}
+
 /// The every-effect survey's third draws (`SURVEY_SEED=2`), `position_torque` k = 1: a k = 58
 /// cogging torque of 0.0301 N·m. The screen put it 12 % low (0.0265 [0.0239, 0.0292]) and the
 /// trajectory refit at 0.0303, so the views disagreed and it was refused; the base model, short
