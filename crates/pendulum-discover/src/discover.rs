@@ -1640,7 +1640,17 @@ pub fn discover(
     loop {
         let sc = match next.take() {
             Some(sc) => sc,
-            None => match second.next(round == 0 && refused.is_none(), base_pinned, first_round) {
+            // With the base pinned, the first round's refusals were judged beside a model that
+            // does not follow the runs (an encoder offset read as friction holding the pendulum
+            // off vertical, b and μ at their bounds): they do not end the search. A hidden
+            // 0.05 rad offset's campaign screened a k = 1 position torque (the offset's own
+            // shape, cos θ, plus sin θ) whose refit disagreed, and a negative breakaway, and
+            // stopped there with `unexplained`; its pinned look names the offset.
+            None => match second.next(
+                round == 0 && (refused.is_none() || base_pinned),
+                base_pinned,
+                first_round,
+            ) {
                 Some(sc) => sc,
                 None => break,
             },
@@ -2207,6 +2217,10 @@ pub fn discover(
         confirmed.push((c.effect.clone(), row.clone()));
         if !accepted && !second_look && refused.is_none() {
             next = queue.pop_front();
+        }
+        if accepted && second_look {
+            // The look's accepted effect supersedes the first round's refusal (see above).
+            refused = None;
         }
         if accepted {
             let ev = refit_objective(&id_runs, &spec);
