@@ -182,8 +182,9 @@ const ONSET_WINDOW_S: f64 = 0.25;
 /// end of the latest window of [`ONSET_WINDOW_S`] before it whose mean square about the quiet
 /// `level` is what the sensor's `noise` alone gives (within 4 standard deviations of a
 /// χ²/n), and whose mean is within 4 standard errors of the level (a crank starting from rest
-/// first pushes the base one way: r φ̈ before φ̇² counts). The start is detected where the short-time RMS passes several times the noise or 5 %
-/// of the full amplitude, so that a glitch is not a start; a smooth spin-up has then been
+/// first pushes the base one way: r φ̈ before φ̇² counts). The start is detected where the
+/// short-time RMS passes several times the noise or 5 % of the full amplitude, so that a glitch
+/// is not a start; a smooth spin-up has then been
 /// shaking the base for a second already (0.3–1.2 s on the twin's captures), and a free segment
 /// ending there held base motion its free model leaves out: at 5 % of full amplitude, 0.07 g,
 /// ten times a cogging torque that the equation error was to find. The walk is bounded by three
