@@ -924,6 +924,33 @@ fn a_breakaway_the_held_out_equation_error_does_not_confirm_is_named_at_its_refi
     );
 }
 
+/// The every-effect survey's first draws, `stribeck` k = 4: a 1.065e-2 N·m breakaway (v_s 0.33
+/// rad/s) whose validate runs' equation error confirmed the screen's size at its profile's shape
+/// (a fall of 27.6 %, 25.5 % needed), so it was named at the screen's 1.623e-2 (+52.4 %) while
+/// its refit, the model the validate runs' E_θ judged, said 9.88e-3 (−7.3 %). A shaped effect's
+/// named value is its refit's.
+#[test]
+fn a_breakaway_whose_equation_error_confirms_the_screen_is_named_at_its_refits_size() {
+    let truth = 0.010651545899594952;
+    let s = discover(
+        6_204,
+        Base::Reference,
+        0.0,
+        0.5,
+        0.15,
+        &format!("stribeck = {{ t_s_nm = {truth}, v_s_rad_s = 0.3256385028776601 }}"),
+    );
+    assert_found(&s, "stribeck", truth, 0.10, 0.0);
+    let row = s.discovery.row("stribeck").unwrap();
+    assert!(
+        row.estimate == row.refit_estimate && (row.screen_estimate - truth).abs() > 0.10 * truth,
+        "estimate {:.4e}, refit {:.4e}, screen {:.4e}",
+        row.estimate,
+        row.refit_estimate,
+        row.screen_estimate
+    );
+}
+
 /// The every-effect survey's other draws (`SURVEY_SEED=1`), `coulomb_constant` k = 1: a
 /// 0.0130 N·m constant dry torque on a mixed design whose two moving identify runs share the
 /// 1.46 kg bob, so that their forced windows cannot tell T_c from μ·load: the refit went to
