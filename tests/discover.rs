@@ -769,6 +769,20 @@ fn a_generator_whose_forced_identify_runs_all_rest_is_refitted_on_their_free_seg
         ),
     );
     assert_found(&s, "generator_rectified", truth, 0.10, 0.0);
+    // Its value is the refit's, and the trajectories hold it tightly: the first steps of the
+    // profile's grid (±10 %) already fit them significantly worse.
+    let row = s.discovery.row("generator_rectified").unwrap();
+    assert!(
+        row.estimate == row.refit_estimate
+            && row.refit_ci_low <= truth
+            && truth <= row.refit_ci_high
+            && row.refit_ci_low >= 0.9 * row.estimate * (1.0 - 1e-12)
+            && row.refit_ci_high <= 1.1 * row.estimate * (1.0 + 1e-12),
+        "estimate {:.4e}, trajectories' range [{:.4e}, {:.4e}]",
+        row.estimate,
+        row.refit_ci_low,
+        row.refit_ci_high
+    );
     assert!(
         s.text.contains("free segment before the shaker starts"),
         "the report says the free segments joined the refits:\n{}",
@@ -948,6 +962,13 @@ fn a_breakaway_whose_equation_error_confirms_the_screen_is_named_at_its_refits_s
         row.estimate,
         row.refit_estimate,
         row.screen_estimate
+    );
+    // The trajectories' own range holds the truth, and says how little they pin it down.
+    assert!(
+        row.refit_ci_low <= truth && truth <= row.refit_ci_high,
+        "trajectories' range [{:.4e}, {:.4e}]",
+        row.refit_ci_low,
+        row.refit_ci_high
     );
 }
 
@@ -1289,8 +1310,13 @@ fn survey_issue_5_every_effect() {
             let unconfirmable = truth_view.is_some_and(|(g, n)| g <= cfg.gain_min.max(n));
             beyond += usize::from(unconfirmable && !(hit && ok_est));
             eprintln!(
-                "survey-every {effect} k={k} truth={truth:.4e} estimate={est:.4e} ({:+.1} %) gain={:.1} % ± {:.1} % eq={:.1} % accepted={accepted:?} unexplained={}{}",
+                "survey-every {effect} k={k} truth={truth:.4e} estimate={est:.4e} ({:+.1} %){} gain={:.1} % ± {:.1} % eq={:.1} % accepted={accepted:?} unexplained={}{}",
                 100.0 * (est / truth - 1.0),
+                row.filter(|r| r.refit_ci_low.is_finite()).map_or(String::new(), |r| format!(
+                    " trajectories' range [{:+.0} %, {:+.0} %]",
+                    100.0 * (r.refit_ci_low / truth - 1.0),
+                    100.0 * (r.refit_ci_high / truth - 1.0)
+                )),
                 100.0 * row.map_or(f64::NAN, |r| r.heldout_gain),
                 100.0 * row.map_or(f64::NAN, |r| r.heldout_noise),
                 100.0 * row.map_or(f64::NAN, |r| r.heldout_eq_gain),

@@ -110,9 +110,20 @@ pub struct DiagnosisRow {
     /// runs), SI; NaN when not refitted. An effect is accepted only when the two agree
     /// ([`views_agree`]).
     pub refit_estimate: f64,
+    /// The identify runs' trajectories' own 95 % range for `refit_estimate`, where it is the
+    /// value named (a shaped effect, accepted: [`trajectory_range`]); NaN otherwise. A lower end
+    /// of 0 says the trajectories cannot tell the size from the effect's absence.
+    #[serde(default = "nan")]
+    pub refit_ci_low: f64,
+    #[serde(default = "nan")]
+    pub refit_ci_high: f64,
     pub e_validate_before: f64,
     pub e_validate_after: f64,
     pub note: String,
+}
+
+fn nan() -> f64 {
+    f64::NAN
 }
 
 /// Everything discover found.
@@ -561,6 +572,8 @@ fn accel_gain_row(ctx: &Context, cfg: &DiscoverConfig) -> Option<DiagnosisRow> {
         heldout_eq_gain: f64::NAN,
         screen_estimate: est,
         refit_estimate: f64::NAN,
+        refit_ci_low: f64::NAN,
+        refit_ci_high: f64::NAN,
         e_validate_before: before,
         e_validate_after: after,
         note: format!(
@@ -691,6 +704,8 @@ fn speed_drift_row(
         heldout_eq_gain: f64::NAN,
         screen_estimate: est,
         refit_estimate: f64::NAN,
+        refit_ci_low: f64::NAN,
+        refit_ci_high: f64::NAN,
         e_validate_before: f64::NAN,
         e_validate_after: f64::NAN,
         note: format!("crank fits with a drifting speed on {n} identify runs; screened out"),
@@ -1326,6 +1341,51 @@ fn refit_profile(
     i: usize,
 ) -> Vec<f64> {
     refit_with(runs, spec, x0, ics, evals, Some((i, x0[i]))).0
+}
+
+/// Multiples of a refit's size at which [`trajectory_range`] profiles it, walking out from 1.
+const RANGE_BELOW: [f64; 6] = [0.9, 0.8, 0.7, 0.5, 0.25, 0.0];
+const RANGE_ABOVE: [f64; 5] = [1.1, 1.25, 1.5, 2.0, 3.0];
+
+/// The identify runs' trajectories' own 95 % range for the size `x[i]` of a refit `x`: the
+/// profile (the other parameters refitted with the size held) at multiples of it walking out
+/// from the refit, each end the first multiple whose profile fits the runs' 0.5 s segments
+/// significantly worse than the refit ([`trajectory_substitution`], one-sided 97.5 %), so the
+/// range is conservative by up to one step of the grid. A lower end of 0 says they cannot tell
+/// the size from the effect's absence; an upper end at 3 × (or the search range's end) that
+/// they hold at least that much. A breakaway's profile is flat: on the survey's fifteen drawn
+/// breakaways (b5a5bf7), the truth's own profile was within the noise of the refit from 0 to 2 ×
+/// the truth in eleven, and no range was narrower than 0.7–1.35 ×.
+fn trajectory_range(
+    runs: &[PreparedRun],
+    spec: &ModelSpec,
+    x: &[f64],
+    ics: &[f64],
+    i: usize,
+    run_zeros: bool,
+    evals: usize,
+) -> (f64, f64) {
+    let seg = substitution_segments(runs, spec, x, ics, run_zeros);
+    let size = x[i];
+    let top = spec.range(spec.params[i]).1;
+    let holds = |v: f64| {
+        let mut start = x.to_vec();
+        start[i] = v;
+        let xp = refit_profile(runs, spec, &start, ics, evals, i);
+        let (g, n) = trajectory_substitution(runs, spec, &seg, &xp, ics, run_zeros);
+        g >= -n
+    };
+    let low = RANGE_BELOW
+        .iter()
+        .map(|m| m * size)
+        .find(|&v| !holds(v))
+        .unwrap_or(0.0);
+    let high = RANGE_ABOVE
+        .iter()
+        .map(|m| (m * size).min(top))
+        .find(|&v| v >= top || !holds(v))
+        .unwrap_or(RANGE_ABOVE[RANGE_ABOVE.len() - 1] * size);
+    (low.min(high), high.max(low))
 }
 
 /// The start of a shaped effect's refit: the point of its shape's grid whose profile (the
@@ -2112,6 +2172,19 @@ pub fn discover(
         // screen was within 3.1 % and the refit within 3.0 %.)
         let shaped_by_trajectories = c.shaped().is_some() && refit_est.is_finite();
         let trajectories_value = second_look || shaped_by_trajectories;
+        // Its named value's own interval, from the view that gave it.
+        let refit_range = match size_index {
+            Some(i) if accepted && shaped_by_trajectories => Some(trajectory_range(
+                &traj_runs,
+                &spec,
+                &refit_x,
+                &traj_ics,
+                i,
+                run_zeros,
+                cfg.refit_evals,
+            )),
+            _ => None,
+        };
         let row = DiagnosisRow {
             effect: c.effect.clone(),
             accepted,
@@ -2130,6 +2203,8 @@ pub fn discover(
             heldout_eq_gain: eq_gain,
             screen_estimate: est,
             refit_estimate: refit_est,
+            refit_ci_low: refit_range.map_or(f64::NAN, |r| r.0),
+            refit_ci_high: refit_range.map_or(f64::NAN, |r| r.1),
             e_validate_before: before,
             e_validate_after: after,
             note: format!(
@@ -2192,6 +2267,16 @@ pub fn discover(
         if shaped_by_trajectories && !second_look {
             row.note.push_str(&format!(
                 "; a shaped effect: the estimate is the trajectory refit's, the value the held-out runs judged (the screen's {est:.4e} {unit}, at its profile's shape)"
+            ));
+        }
+        if let Some((lo, hi)) = refit_range {
+            row.note.push_str(&format!(
+                "; the identify runs' trajectories hold it within [{lo:.4e}, {hi:.4e}] {unit} (its profile's 95 % range{})",
+                if lo == 0.0 {
+                    ": they cannot tell its size from its absence"
+                } else {
+                    ""
+                }
             ));
         }
         if accepted && second_look && unpins && eq_gain <= eq_needed {
@@ -2302,6 +2387,8 @@ pub fn discover(
             heldout_eq_gain: f64::NAN,
             screen_estimate: est,
         refit_estimate: f64::NAN,
+        refit_ci_low: f64::NAN,
+        refit_ci_high: f64::NAN,
             e_validate_before: f64::NAN,
             e_validate_after: f64::NAN,
             note: if sc.candidate.effect == "position_torque" {
@@ -2545,6 +2632,8 @@ pub fn discover(
             heldout_eq_gain: f64::NAN,
             screen_estimate: f64::NAN,
             refit_estimate: f64::NAN,
+            refit_ci_low: f64::NAN,
+            refit_ci_high: f64::NAN,
             e_validate_before: f64::NAN,
             e_validate_after: f64::NAN,
             note: w.clone(),

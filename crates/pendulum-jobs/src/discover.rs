@@ -126,6 +126,24 @@ pub fn diagnosis_table(d: &Discovery) -> String {
             pct(r.heldout_eq_gain)
         );
     }
+    // A value named from the trajectories, with their own range (the screen's interval above
+    // is the other view's).
+    for r in d.rows.iter().filter(|r| r.refit_ci_low.is_finite()) {
+        let _ = writeln!(
+            t,
+            "{}: named at its trajectory refit's {:.4e} {}; the identify runs' trajectories hold it within [{:.3e}, {:.3e}]{}",
+            r.effect,
+            r.estimate,
+            r.unit,
+            r.refit_ci_low,
+            r.refit_ci_high,
+            if r.refit_ci_low == 0.0 {
+                " (down to 0: they cannot tell its size from its absence)"
+            } else {
+                ""
+            }
+        );
+    }
     t
 }
 
@@ -330,6 +348,16 @@ fn run_unmarked(job: &DiscoverJob) -> Result<DiscoverSummary, JobError> {
                 rows.iter().map(|r| r.refit_estimate).collect(),
                 "refit_estimate",
                 "see column unit (NaN: not refitted)",
+            ),
+            f(
+                rows.iter().map(|r| r.refit_ci_low).collect(),
+                "refit_ci_low",
+                "see column unit (the trajectories' 95 % range for refit_estimate where it is the value named; NaN otherwise)",
+            ),
+            f(
+                rows.iter().map(|r| r.refit_ci_high).collect(),
+                "refit_ci_high",
+                "see column unit (as refit_ci_low)",
             ),
             f(
                 rows.iter().map(|r| r.e_validate_before).collect(),
