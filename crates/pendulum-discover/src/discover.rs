@@ -1354,8 +1354,8 @@ const RANGE_ABOVE: [f64; 5] = [1.1, 1.25, 1.5, 2.0, 3.0];
 /// range is conservative by up to one step of the grid. A lower end of 0 says they cannot tell
 /// the size from the effect's absence; an upper end at 3 × (or the search range's end) that
 /// they hold at least that much. A breakaway's profile is flat: on the survey's fifteen drawn
-/// breakaways (b5a5bf7), the truth's own profile was within the noise of the refit from 0 to 2 ×
-/// the truth in eleven, and no range was narrower than 0.7–1.35 ×.
+/// breakaways (b5a5bf7), the profile held at 0–2 × the truth was within the noise of the refit
+/// everywhere in eleven, and in every one at least from 0.8 to 1.2 × the truth.
 fn trajectory_range(
     runs: &[PreparedRun],
     spec: &ModelSpec,
