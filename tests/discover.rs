@@ -675,7 +675,7 @@ fn regression_issue_5_finds_dry_torque_and_position_torque_together() {
 /// (11.5 % needed), but the identify trajectories cannot tell it from its absence, and judging
 /// that with their still tails kept did not change it (tried, not kept).
 #[test]
-#[ignore = "known failure (issue 14) since 037fd0f: the views disagree on this draw's breakaway and it is not named; see the doc comment"]
+#[ignore = "known failure (issue 14) since 037fd0f: this draw's breakaway is not named (on 97f6dd9: its trajectories cannot tell it from its absence, refit 6.82e-3 N·m, the validate runs' equation error 11.9 % against 13.2 % needed); see the doc comment"]
 fn issue_14_second_look_names_the_breakaway_not_a_constant_dry_torque() {
     let (truth, spec, base, a, b, mu) = draw("stribeck", &mut rng(14_000));
     eprintln!(
@@ -698,7 +698,7 @@ fn issue_14_second_look_names_the_breakaway_not_a_constant_dry_torque() {
 /// the survey's named breakaways are off by −36 % and +19 % too (README): the refit trades T_s
 /// against v_s and μ, and the screen's value against v_s.
 #[test]
-#[ignore = "known failure (issue 14): the breakaway is named but its T_s is 50 % low on this draw; see the doc comment"]
+#[ignore = "known failure (issue 14): on 97f6dd9 this draw's breakaway is not named (refit 6.82e-3 N·m; the trajectories cannot tell it from its absence); it was named 50 % low before; see the doc comment"]
 fn issue_14_finds_stribeck_and_tells_it_from_coulomb_constant() {
     let s = found_when_hidden("stribeck", 14_000, 14_001);
     assert!(!s.discovery.accepted().contains(&"coulomb_constant"));
@@ -713,7 +713,7 @@ fn issue_14_finds_stribeck_and_tells_it_from_coulomb_constant() {
 /// E_θ fall, 11.5 % ± 6.5 %, is short of the second look's twice-the-bar, and the validate
 /// runs' equation error cannot see it either; the truth itself scores 12.1 % ± 6.6 % there.)
 #[test]
-#[ignore = "known failure (issue 14) since c05ca28: with the free segments in the refit, its flat profile ends at 4.41e-3 N·m (−27.8 %)"]
+#[ignore = "known failure (issue 14) since c05ca28: with the free segments in the refit, its flat profile ends at 4.48e-3 N·m (−26.6 % on 97f6dd9; −27.8 % on c05ca28)"]
 fn a_breakaway_the_screen_puts_at_the_wrong_speed_is_refitted_at_the_one_the_trajectories_prefer() {
     let truth = 6.101608974847369e-3;
     let s = discover(
@@ -916,7 +916,7 @@ fn a_tilt_met_before_the_runs_zeroing_error_is_named_alone() {
 /// their equation error did not confirm the screen's size (a fall of 2.9 %, 5.0 % needed): the
 /// estimate named is the value the held-out runs confirmed, the refit's, within 10 %.
 #[test]
-#[ignore = "known failure (issue 14) since c05ca28: named at its refit's 6.65e-3 N·m (−32.4 %, v_s 0.51); its trajectories cannot tell its size from its absence"]
+#[ignore = "known failure (issue 14) since c05ca28: named at its refit's 8.55e-3 N·m on 97f6dd9 (−13.0 %; −32.4 % on c05ca28); its trajectories cannot tell its size from its absence"]
 fn a_breakaway_the_held_out_equation_error_does_not_confirm_is_named_at_its_refits_size() {
     let truth = 9.829800115062686e-3;
     let s = discover(
