@@ -314,6 +314,52 @@ fn regression_issue_7_free_segments_fitted_as_free_decays() {
     assert!(ids.iter().all(|id| id.ends_with("-free")), "{ids:?}");
 }
 
+/// A drawn design whose second identify run is started by hand at −0.005 rad: its free segment
+/// holds no swing, so it cannot be aligned as a free decay ("only 0 turning points"). That one
+/// segment is left out, saying why, and the others are fitted; before, the whole
+/// `--free-segments` fit failed with it (and discover's trajectory refits lost every free
+/// segment, which let a nothing-hidden campaign's damping wander into another basin).
+#[test]
+fn a_free_segment_at_rest_is_left_out_alone() {
+    let dir = tempfile::tempdir().unwrap();
+    let camp = dir.path().join("campaign");
+    make_campaign(
+        &camp,
+        &pendulum_jobs::demo::discovery_campaign(
+            "hidden",
+            5_204,
+            0.0,
+            0.4768914291264561,
+            0.15,
+            "",
+        ),
+    );
+    let out = dir.path().join("out");
+    let s = run(&IdentifyJob {
+        input: camp,
+        out: out.clone(),
+        pipeline: None,
+        overrides: FitOverrides {
+            generations: Some(60),
+            ..FitOverrides::default()
+        },
+        progress: false,
+        free_segments: true,
+    })
+    .unwrap();
+    let text = s.to_string();
+    assert!(
+        text.contains("free segment r02-free left out: ") && text.contains("turning points"),
+        "{text}"
+    );
+    let ids = column_str(&out.join("free_segments").join("runs.parquet"), "run_id");
+    assert!(!ids.iter().any(|id| id == "r02-free"), "{ids:?}");
+    assert!(
+        ids.len() >= 3 && ids.iter().all(|id| id.ends_with("-free")),
+        "{ids:?}"
+    );
+}
+
 /// Dry friction past the study's search range (0 < μ < 0.25) on a drawn design (bob, crank,
 /// speed, format, hand start per run): the fit widens the range it was pinned at, instead of
 /// returning 0.25 with the other terms bent to make up the rest (before the ranges widened, this

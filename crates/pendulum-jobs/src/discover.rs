@@ -251,15 +251,8 @@ fn run_unmarked(job: &DiscoverJob) -> Result<DiscoverSummary, JobError> {
         b.finish_and_clear();
     }
     res?;
-    let free = match identify_free_segments(&ctx, &stages, &pipe.discover) {
-        Ok(free) => free,
-        Err(e) => {
-            ctx.notes.push(format!(
-                "the identify runs' free segments before the shakers start could not be prepared ({e}): the trajectory refits follow the forced windows only"
-            ));
-            Vec::new()
-        }
-    };
+    let (free, left_out) = identify_free_segments(&ctx, &stages, &pipe.discover);
+    ctx.notes.extend(left_out);
     if !free.is_empty() {
         ctx.notes.push(format!(
             "the trajectory refits also follow the free segment before the shaker starts of {} identify run(s) (one at rest adds nothing)",
@@ -1345,61 +1338,50 @@ fn write_report(
 /// [`crate::identify::FREE_SEGMENT_MIN_S`]), aligned, started and prepared as free decays by the
 /// pipeline's own stages (not its fit), then as runs of the shaker model with the crank still
 /// ([`pendulum_process::fit::PreparedRun::unforced`]): discover's trajectory refits see the
-/// damping over the run's widest swings. A segment whose initial state or preparation fails is
-/// left out; a stage that fails the whole set is the error.
+/// damping over the run's widest swings. A segment the stages cannot read, or whose preparation
+/// fails, is left out (the second value: a note per segment the stages refused).
 fn identify_free_segments(
     ctx: &Context,
     stages: &PipelineConfig,
     cfg: &DiscoverConfig,
-) -> Result<Vec<pendulum_process::fit::PreparedRun>, pendulum_process::ProcessError> {
+) -> (Vec<pendulum_process::fit::PreparedRun>, Vec<String>) {
     let runs: Vec<_> = crate::identify::free_segment_runs(ctx)
         .into_iter()
         .filter(|r| r.role == Role::Identify)
         .collect();
-    if runs.is_empty() {
-        return Ok(Vec::new());
-    }
-    let pre = PipelineConfig {
-        name: stages.name.clone(),
-        stages: stages
-            .stages
-            .iter()
-            .filter(|s| !matches!(s, StageConfig::Fit(_) | StageConfig::Validate(_)))
-            .cloned()
-            .collect(),
-    };
-    let mut fctx = Context::new(runs);
-    pre.run(&mut fctx)?;
+    let (kept, left_out) = crate::identify::prepared_free_segments(runs, stages);
     let mut out = Vec::new();
-    for run in &fctx.runs {
-        // One "-free" (`free_segment_runs`' suffix): a run the user named "warm-free" is
-        // "warm-free-free" here.
-        let Some(omega_hz) = run
-            .id
-            .strip_suffix("-free")
-            .and_then(|parent| ctx.alignments.get(parent))
-            .map(|a| a.omega_hz)
-        else {
-            continue;
-        };
-        let (Some(al), Some(ic), Some(st)) = (
-            fctx.alignments.get(&run.id),
-            fctx.initial.get(&run.id),
-            fctx.steady.get(&run.id),
-        ) else {
-            continue;
-        };
-        let Ok(p) = pendulum_process::identify::prepare_run(
-            run,
-            al,
-            ic,
-            st,
-            &fctx.steady_cfg,
-            &cfg.validate.window,
-        ) else {
-            continue;
-        };
-        out.extend(p.unforced(omega_hz));
+    for fctx in &kept {
+        for run in &fctx.runs {
+            // One "-free" (`free_segment_runs`' suffix): a run the user named "warm-free" is
+            // "warm-free-free" here.
+            let Some(omega_hz) = run
+                .id
+                .strip_suffix("-free")
+                .and_then(|parent| ctx.alignments.get(parent))
+                .map(|a| a.omega_hz)
+            else {
+                continue;
+            };
+            let (Some(al), Some(ic), Some(st)) = (
+                fctx.alignments.get(&run.id),
+                fctx.initial.get(&run.id),
+                fctx.steady.get(&run.id),
+            ) else {
+                continue;
+            };
+            let Ok(p) = pendulum_process::identify::prepare_run(
+                run,
+                al,
+                ic,
+                st,
+                &fctx.steady_cfg,
+                &cfg.validate.window,
+            ) else {
+                continue;
+            };
+            out.extend(p.unforced(omega_hz));
+        }
     }
-    Ok(out)
+    (out, left_out)
 }

@@ -82,6 +82,38 @@ pub fn free_segment_runs(ctx: &Context) -> Vec<RunData> {
     out
 }
 
+/// Each free segment through `stages` before the fit (and validation), one segment at a time:
+/// a segment that cannot be read as a free decay is left out with the reason, not every other
+/// segment with it. A bob hanging still until its shaker starts has no swing to align on ("only
+/// 0 turning points"); on a drawn design one such segment took the seven others out of
+/// discover's refits, whose damping then wandered to another basin.
+/// Returns each kept segment's own context, and a note per segment left out.
+pub fn prepared_free_segments(
+    free: Vec<RunData>,
+    stages: &PipelineConfig,
+) -> (Vec<Context>, Vec<String>) {
+    let pre = PipelineConfig {
+        name: stages.name.clone(),
+        stages: stages
+            .stages
+            .iter()
+            .filter(|s| !matches!(s, StageConfig::Fit(_) | StageConfig::Validate(_)))
+            .cloned()
+            .collect(),
+    };
+    let mut kept = Vec::new();
+    let mut left_out = Vec::new();
+    for run in free {
+        let id = run.id.clone();
+        let mut ctx = Context::new(vec![run]);
+        match pre.run(&mut ctx) {
+            Ok(()) => kept.push(ctx),
+            Err(e) => left_out.push(format!("free segment {id} left out: {e}")),
+        }
+    }
+    (kept, left_out)
+}
+
 /// Loads a pipeline file or the built-in one.
 pub fn load_pipeline(
     path: Option<&Path>,
@@ -310,10 +342,14 @@ pub fn run(job: &IdentifyJob) -> Result<OutputSummary, JobError> {
         &inputs,
     )?;
     if job.free_segments {
-        let free = free_segment_runs(&ctx);
+        let (kept, left_out) = prepared_free_segments(free_segment_runs(&ctx), &pipeline);
+        for note in &left_out {
+            summary.text += &format!("\n{note}");
+        }
+        let free: Vec<RunData> = kept.into_iter().flat_map(|c| c.runs).collect();
         if !free.iter().any(|r| r.role == Role::Identify) {
             summary.text += &format!(
-                "\nfree segments: none of at least {FREE_SEGMENT_MIN_S} s before a shaker start in an identify run; not fitted\n"
+                "\nfree segments: none of at least {FREE_SEGMENT_MIN_S} s before a shaker start in an identify run that reads as a free decay; not fitted\n"
             );
             return completed(&job.out, "pendulum identify", summary);
         }
