@@ -264,6 +264,26 @@ fn regression_issue_6_identify_same_from_mcap_as_from_raw() {
     }
 }
 
+/// `pendulum identify --free-segments` of `camp` into `out` at `generations`.
+fn identify_with_free_segments(
+    camp: std::path::PathBuf,
+    out: &Path,
+    generations: u64,
+) -> pendulum_jobs::outputs::OutputSummary {
+    run(&IdentifyJob {
+        input: camp,
+        out: out.to_path_buf(),
+        pipeline: None,
+        overrides: FitOverrides {
+            generations: Some(generations),
+            ..FitOverrides::default()
+        },
+        progress: false,
+        free_segments: true,
+    })
+    .unwrap()
+}
+
 /// Issue 7 item 2: the free-motion segment before each shaker start goes through the same
 /// stages as a free decay (excitation off, identifiable terms) and recovers the twin's truth:
 /// ω0 = sqrt(g/l), β = b/(m ω0), M = μ r_b/l.
@@ -283,18 +303,7 @@ fn regression_issue_7_free_segments_fitted_as_free_decays() {
     let (b, mu) = (0.5, 0.15);
     make_campaign(&camp, &campaign_toml(71, 0.0, b, mu));
     let out = dir.path().join("out");
-    let s = run(&IdentifyJob {
-        input: camp,
-        out: out.clone(),
-        pipeline: None,
-        overrides: FitOverrides {
-            generations: Some(150),
-            ..FitOverrides::default()
-        },
-        progress: false,
-        free_segments: true,
-    })
-    .unwrap();
+    let s = identify_with_free_segments(camp, &out, 150);
     eprintln!("{s}");
     let p = out.join("free_segments").join("params.parquet");
     let (m, l, r_b, g): (f64, f64, f64, f64) = (1.46, 0.265, 0.01225, 9.81);
@@ -335,18 +344,7 @@ fn a_free_segment_at_rest_is_left_out_alone() {
         ),
     );
     let out = dir.path().join("out");
-    let s = run(&IdentifyJob {
-        input: camp,
-        out: out.clone(),
-        pipeline: None,
-        overrides: FitOverrides {
-            generations: Some(60),
-            ..FitOverrides::default()
-        },
-        progress: false,
-        free_segments: true,
-    })
-    .unwrap();
+    let s = identify_with_free_segments(camp, &out, 60);
     let text = s.to_string();
     assert!(
         text.contains("free segment r02-free left out: ") && text.contains("turning points"),
