@@ -85,8 +85,8 @@ pub fn free_segment_runs(ctx: &Context) -> Vec<RunData> {
 /// Each free segment through `stages` before the fit (and validation), one segment at a time:
 /// a segment that cannot be read as a free decay is left out with the reason, not every other
 /// segment with it. A bob hanging still until its shaker starts has no swing to align on ("only
-/// 0 turning points"); on a drawn design one such segment took the seven others out of
-/// discover's refits, whose damping then wandered to another basin.
+/// 0 turning points"); on a drawn design one such segment took the other four identify runs'
+/// segments out of discover's refits, whose damping then wandered to another basin.
 /// Returns each kept segment's own context, and a note per segment left out.
 pub fn prepared_free_segments(
     free: Vec<RunData>,
