@@ -221,8 +221,31 @@ impl Stage for AlignStage {
             .par_iter()
             .map(|r| (r.id.clone(), align(r, &self.0)))
             .collect();
+        // A run that cannot be aligned (its accelerometer never leaves its quiet level, fewer
+        // than five crank turns at speed, a free decay without swings) is left out of the
+        // analysis with a note, as the initial-state stage leaves out a run whose state cannot
+        // be estimated: one bad capture need not take a campaign's other runs with it. (Every
+        // run left out is still an error: there is nothing to analyse.)
+        let n = results.len();
+        let mut left_out = Vec::new();
         for (id, res) in results {
-            ctx.alignments.insert(id, res?);
+            match res {
+                Ok(al) => {
+                    ctx.alignments.insert(id, al);
+                }
+                Err(ProcessError::Align { reason, .. }) if n > 1 => left_out.push((id, reason)),
+                Err(e) => return Err(e),
+            }
+        }
+        if left_out.len() == n {
+            let (run, reason) = left_out.swap_remove(0);
+            return Err(ProcessError::Align { run, reason });
+        }
+        for (id, why) in left_out {
+            ctx.runs.retain(|r| r.id != id);
+            ctx.notes.push(format!(
+                "run {id} is left out of the analysis: it cannot be aligned ({why})"
+            ));
         }
         Ok(())
     }
