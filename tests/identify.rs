@@ -414,7 +414,7 @@ fn a_run_that_cannot_be_aligned_is_left_out_not_the_campaign() {
     let n_runs = campaign.matches("[[run]]").count();
     let left_out = text.matches("is left out of the analysis").count();
     assert!(
-        !ids.iter().any(|id| *id == bad) && ids.len() == n_runs - left_out && left_out <= 2,
+        !ids.contains(&bad) && ids.len() == n_runs - left_out && left_out <= 2,
         "{ids:?} of {n_runs} runs, {left_out} left out"
     );
 
