@@ -1073,7 +1073,7 @@ const WEIGHT_FIT_MAX_GROUP: u32 = 4;
 /// validate runs' E_θ of the model before it: both held-out views. (Without that last bar an
 /// encoder counting 7 % under its header was named a 0.039 kg·m² extra inertia and a 1.8 N·m
 /// position torque together, on the equation error alone, while the validate runs' E_θ moved
-/// 2.2 %; the lag and the tilt above take 72 % off it.) Otherwise everything returns to where
+/// 2.2 %; the lag and the tilt above take 67.9 % off it, 18.7 % needed.) Otherwise everything returns to where
 /// the first's refusal left it, and the second is judged alone as before. Once per campaign.
 struct PairLook {
     /// The first candidate, held provisionally.
