@@ -591,7 +591,7 @@ fn regression_issue_5_dry_base_finds_viscous_drag() {
 /// Hides two effects drawn as in [`draw`] (seeded by `tag`) in one twin campaign (reference
 /// base) and checks that exactly those two are named, each within its tolerance (25 %; encoder
 /// offset 0.01 rad), with a positive held-out gain.
-fn assert_pair_found(tag: u64, seed: u64, e1: &str, e2: &str) {
+fn assert_pair_found(tag: u64, seed: u64, e1: &str, e2: &str) -> DiscoverSummary {
     let mut r = rng(tag);
     let (t1, s1, _, _, _, _) = draw(e1, &mut r);
     let (t2, s2, _, _, _, _) = draw(e2, &mut r);
@@ -628,6 +628,7 @@ fn assert_pair_found(tag: u64, seed: u64, e1: &str, e2: &str) {
             row.heldout_gain
         );
     }
+    s
 }
 
 /// A pair: two effects hidden together must both be named (and nothing else).
@@ -643,7 +644,13 @@ fn regression_issue_5_finds_a_pair() {
 /// named. The pair look holds the first provisionally and judges the second beside it.
 #[test]
 fn a_lag_and_a_tilt_that_each_spoil_the_others_held_out_views_are_named_as_a_pair() {
-    assert_pair_found(103_001, 107_001, "accel_delay", "horizontal_base");
+    let s = assert_pair_found(103_001, 107_001, "accel_delay", "horizontal_base");
+    // Named by the pair look, which says so in the first one's row.
+    let note = &s.discovery.row("accel_delay").unwrap().note;
+    assert!(
+        note.contains("named as a pair with horizontal_base"),
+        "{note}"
+    );
 }
 
 /// A large encoder offset's linearised remainder (θ_off²/2 · sin θ) looks like extra inertia: the
