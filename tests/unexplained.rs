@@ -367,7 +367,7 @@ type DrawDeparture = fn(&mut rand_chacha::ChaCha8Rng) -> String;
 /// The survey's departures, each with how its size is drawn: wider than the regression tests
 /// above (springs from barely felt to stiff, encoders mislabelled on either side of their
 /// header, plays, growths and run spreads from small to large).
-const DEPARTURES: [(&str, DrawDeparture); 7] = [
+const DEPARTURES: [(&str, DrawDeparture); 8] = [
     ("torsion_spring", |r| {
         let k = (r.random_range(0.02f64.ln()..0.3f64.ln())).exp();
         format!("torsion_spring_nm_per_rad = {k}")
@@ -398,6 +398,13 @@ const DEPARTURES: [(&str, DrawDeparture); 7] = [
         let anchor = r.random_range(0.1..0.6) * if r.random_bool(0.5) { 1.0 } else { -1.0 };
         format!("torsion_spring_nm_per_rad = {k}\ncable_anchor_rad = {anchor}")
     }),
+    ("bob_bounce", |r| {
+        // A bob on a springy mount, from soft (3 Hz, near the crank's second harmonic) to stiff
+        // (12 Hz), lightly to well damped.
+        let hz = (r.random_range(3f64.ln()..12f64.ln())).exp();
+        let zeta = r.random_range(0.02..0.2);
+        format!("bob_bounce_hz = {hz}\nbob_bounce_damping_ratio = {zeta}")
+    }),
 ];
 
 /// The survey's campaign `k` of departure `name`: (campaign seed, b, μ, the departure's lines).
@@ -423,7 +430,7 @@ fn drawn_departure(name: &str, k: u64, off: u64) -> (u64, f64, f64, String) {
 /// cause). `DEPARTURE_ONE=name:k` re-runs one (`KEEP_DEP=PREFIX` keeps its case);
 /// `DEPARTURE_SEED=s` draws other campaigns.
 #[test]
-#[ignore = "survey for issue 14 item 3: 7 departures × DEPARTURE_N (default 3) drawn campaigns; ~3 minutes on 2 cores"]
+#[ignore = "survey for issue 14 item 3: 8 departures × DEPARTURE_N (default 3) drawn campaigns; ~3 minutes on 2 cores"]
 fn survey_departures_name_nothing() {
     let n: u64 = std::env::var("DEPARTURE_N")
         .ok()

@@ -32,7 +32,7 @@ pub struct Term {
 }
 
 /// The library, in the order of [`library_values`].
-pub const LIBRARY: [Term; 22] = [
+pub const LIBRARY: [Term; 23] = [
     t(
         "θ̇",
         Variable::Rate,
@@ -130,6 +130,15 @@ pub const LIBRARY: [Term; 22] = [
         "a friction growing with time",
         "s",
     ),
+    // The gravity torque's size following the speed: a bob that moves out as it speeds up (loose
+    // or springy on its rod; its centrifugal stretch grows with θ̇², and with it the gravity
+    // torque and the inertia, whose change shows through θ̈ ≈ −(1 + A_y) sin θ the same way).
+    t(
+        "θ̇² (1 + A_y) sin θ",
+        Variable::Rate,
+        "the gravity torque growing with (dθ/dt)² (a bob that moves out as it speeds up: loose or springy on its rod)",
+        "(rad/s)²",
+    ),
 ];
 
 /// Library terms that are, alone, a catalogue effect's own torque shape (the effect's regressor
@@ -146,7 +155,10 @@ pub const CATALOGUE_TWINS: [(&str, &str); 3] = [
 /// t sgn θ̇ forces the torque through zero at t = 0, and its slope then takes what the
 /// catalogue's own dry friction (refitted along) leaves of the growth: a 2.56e-4 N·m/s growth was
 /// described as 1.89e-4.
-const MAIN_EFFECT: [(&str, &str); 1] = [("t sgn θ̇", "sgn θ̇")];
+///
+/// Likewise the gravity torque growing with θ̇² enters with sin θ: its size at rest is the model's
+/// own gravity, whose error (a bob a little heavier or longer than declared) is sin θ alone.
+const MAIN_EFFECT: [(&str, &str); 2] = [("t sgn θ̇", "sgn θ̇"), ("θ̇² (1 + A_y) sin θ", "sin θ")];
 
 /// The library index of term `j`'s main effect, if it has one.
 fn main_effect(j: usize) -> Option<usize> {
@@ -220,6 +232,7 @@ pub fn library_values(
         c2p,
         t_s,
         t_s * sg,
+        theta_dot * theta_dot * (1.0 + a_y) * theta.sin(),
     ]
 }
 

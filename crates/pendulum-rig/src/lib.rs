@@ -4,6 +4,7 @@
 //! Readers stream in constant memory, never panic on damaged input, and report what they
 //! dropped (with line numbers or byte offsets) in [`IngestStats`].
 
+pub mod bounce;
 pub mod campaign;
 pub mod capture;
 pub mod crc8;

@@ -1,0 +1,267 @@
+//! A bob that bounces on a springy mount: a departure outside the catalogue (effects.md, last
+//! paragraph: "a bob that wobbles"), for the twin only. The analysis has no name for it, so it is
+//! not in the model's simulator; the twin integrates it here, with its own integrator, as an
+//! independent simulator would.
+//!
+//! The bob (the model's point mass) sits on a mount that gives along the rod: its distance from
+//! the axis is r = l ρ, held at ρ = 1 when hanging at rest (the mount's pretension carries its
+//! weight), with a radial natural frequency ν ω0 and damping ratio ζ. Per m g l, in τ = ω0 t:
+//!
+//! ```text
+//! (ρ² + j) θ'' + 2 ρ ρ' θ' = ρ (−(1 + A_y) sin θ − A_x cos θ) − friction(θ, θ') − T_pos − spring
+//!           ρ'' − ρ θ'² = (1 + A_y) cos θ − A_x sin θ − 1 − ν² (ρ − 1) − 2 ζ ν ρ'
+//! ```
+//!
+//! (the Lagrangian ½(ρ'² + ρ² θ'²) + ρ cos θ − ρ − ½ ν² (ρ − 1)² with the base's motion and the
+//! shaft's losses). Drag acts on the bob, so its viscous and quadratic terms take ρ² and ρ³.
+//! The shaft's dry friction is regularised within ±`V_EPS` of θ' = 0 (a stiff linear zone
+//! instead of the model's exact stick/slip: a stuck pendulum creeps at most `V_EPS`·τ, far
+//! below an encoder count over a run), and the step is chosen so that zone stays stable.
+
+use std::ops::ControlFlow;
+
+use pendulum_model::{Model, Sample};
+
+/// Half-width of the regularised dry friction's linear zone in θ' (per ω0).
+const V_EPS: f64 = 1e-6;
+
+/// The bob's mount: radial natural frequency per ω0 and damping ratio.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Mount {
+    pub nu: f64,
+    pub zeta: f64,
+}
+
+/// State (θ, θ', ρ, ρ').
+type State = [f64; 4];
+
+fn rhs(model: &Model, m: Mount, t: f64, y: State) -> State {
+    let [theta, w, rho, rw] = y;
+    let tq = model.torques(t, theta, w);
+    let dry = if w.abs() < V_EPS {
+        tq.dry * w.abs() / V_EPS
+    } else {
+        tq.dry
+    };
+    let (ay, ax) = model.excitation.accel(t);
+    let (s, c) = theta.sin_cos();
+    let q = rho * (tq.gravity + tq.base)
+        + rho * rho * tq.viscous
+        + rho * rho * rho * tq.quadratic
+        + dry
+        + tq.generator
+        + tq.position
+        + tq.spring
+        - 2.0 * rho * rw * w;
+    let acc = q / (rho * rho + model.params.j);
+    let racc = rho * w * w + (1.0 + ay) * c
+        - ax * s
+        - 1.0
+        - m.nu * m.nu * (rho - 1.0)
+        - 2.0 * m.zeta * m.nu * rw;
+    [w, acc, rw, racc]
+}
+
+/// The step (per ω0): a fiftieth of the mount's period and of the forcing's, and within the
+/// stability of the friction's linear zone (slope ≈ D/V_EPS for the largest dry torque D).
+fn step(model: &Model, m: Mount, t_end: f64) -> f64 {
+    let p = &model.params;
+    let dry_max = p.m_coulomb * 3.0 + p.c + p.s_break + p.c_rate * t_end.max(0.0);
+    let mut h = 1e-3f64.min(2.0 * std::f64::consts::PI / (50.0 * m.nu.max(1e-9)));
+    if p.omega > 0.0 {
+        h = h.min(2.0 * std::f64::consts::PI / (50.0 * p.omega));
+    }
+    if dry_max > 0.0 {
+        h = h.min(1.5 * V_EPS / dry_max);
+    }
+    h
+}
+
+/// Integrates from (θ0, θ'0) with the bob at rest on its mount (ρ = 1, ρ' = 0) over [t0, t_end],
+/// handing `sink` the shaft's (θ, θ') at each of `times` (ascending, in [t0, t_end]) by cubic
+/// Hermite interpolation within a classic fourth-order Runge–Kutta step.
+pub fn integrate<I, F>(
+    model: &Model,
+    mount: Mount,
+    t0: f64,
+    y0: [f64; 2],
+    t_end: f64,
+    times: I,
+    mut sink: F,
+) where
+    I: IntoIterator<Item = f64>,
+    F: FnMut(Sample) -> ControlFlow<()>,
+{
+    let h = step(model, mount, t_end);
+    let mut t = t0;
+    let mut y: State = [y0[0], y0[1], 1.0, 0.0];
+    let mut f = rhs(model, mount, t, y);
+    for tq in times {
+        while t + h < tq {
+            let k1 = f;
+            let at = |y: &State, k: &State, a: f64| -> State {
+                [
+                    y[0] + a * k[0],
+                    y[1] + a * k[1],
+                    y[2] + a * k[2],
+                    y[3] + a * k[3],
+                ]
+            };
+            let k2 = rhs(model, mount, t + 0.5 * h, at(&y, &k1, 0.5 * h));
+            let k3 = rhs(model, mount, t + 0.5 * h, at(&y, &k2, 0.5 * h));
+            let k4 = rhs(model, mount, t + h, at(&y, &k3, h));
+            for i in 0..4 {
+                y[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
+            }
+            t += h;
+            f = rhs(model, mount, t, y);
+        }
+        // The last partial step to tq, taken on a copy (the grid stays uniform).
+        let dt = tq - t;
+        let (theta, w) = if dt <= 0.0 {
+            (y[0], y[1])
+        } else {
+            let k1 = f;
+            let at = |k: &State, a: f64| -> State {
+                [
+                    y[0] + a * k[0],
+                    y[1] + a * k[1],
+                    y[2] + a * k[2],
+                    y[3] + a * k[3],
+                ]
+            };
+            let k2 = rhs(model, mount, t + 0.5 * dt, at(&k1, 0.5 * dt));
+            let k3 = rhs(model, mount, t + 0.5 * dt, at(&k2, 0.5 * dt));
+            let k4 = rhs(model, mount, t + dt, at(&k3, dt));
+            (
+                y[0] + dt / 6.0 * (k1[0] + 2.0 * k2[0] + 2.0 * k3[0] + k4[0]),
+                y[1] + dt / 6.0 * (k1[1] + 2.0 * k2[1] + 2.0 * k3[1] + k4[1]),
+            )
+        };
+        if sink(Sample {
+            t: tq,
+            theta,
+            theta_dot: w,
+        })
+        .is_break()
+        {
+            return;
+        }
+        if t_end <= t {
+            break;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use pendulum_model::{simulate, Dimensionless, Excitation, Physical, SimOptions};
+
+    fn free(d: Dimensionless) -> Model {
+        Model::with_excitation(d, Excitation::None)
+    }
+
+    fn lossless() -> Dimensionless {
+        let mut d = Physical::default().to_dimensionless();
+        d.beta = 0.0;
+        d.alpha = 0.0;
+        d.m_coulomb = 0.0;
+        d.c = 0.0;
+        d
+    }
+
+    /// Without losses the mount's energy ½(ρ'² + ρ²θ'²) − ρ cos θ + ρ + ½ν²(ρ − 1)² is kept:
+    /// the conservation law the equations come from, checked on a swing that stretches the mount
+    /// (over the top: the centrifugal load pulls the bob out).
+    #[test]
+    fn a_lossless_bouncing_bob_keeps_its_energy() {
+        let model = free(lossless());
+        let mount = Mount { nu: 4.0, zeta: 0.0 };
+        let energy = |y: &State| {
+            0.5 * (y[3] * y[3] + y[2] * y[2] * y[1] * y[1]) - y[2] * y[0].cos()
+                + y[2]
+                + 0.5 * mount.nu * mount.nu * (y[2] - 1.0).powi(2)
+        };
+        // The state along the way, integrated by hand with the module's step.
+        let h = step(&model, mount, 50.0);
+        let mut y: State = [0.0, 2.3, 1.0, 0.0];
+        let e0 = energy(&y);
+        let mut t = 0.0;
+        let mut rho_max = 1.0f64;
+        while t < 50.0 {
+            let k1 = rhs(&model, mount, t, y);
+            let at = |k: &State, a: f64| {
+                [
+                    y[0] + a * k[0],
+                    y[1] + a * k[1],
+                    y[2] + a * k[2],
+                    y[3] + a * k[3],
+                ]
+            };
+            let k2 = rhs(&model, mount, t + 0.5 * h, at(&k1, 0.5 * h));
+            let k3 = rhs(&model, mount, t + 0.5 * h, at(&k2, 0.5 * h));
+            let k4 = rhs(&model, mount, t + h, at(&k3, h));
+            for i in 0..4 {
+                y[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
+            }
+            t += h;
+            rho_max = rho_max.max(y[2]);
+        }
+        assert!(y[0] > 2.0 * std::f64::consts::PI, "it goes over the top");
+        assert!(rho_max > 1.1, "the mount gives: ρ reached {rho_max}");
+        assert!((energy(&y) - e0).abs() < 1e-9, "{} vs {e0}", energy(&y));
+    }
+
+    /// A stiff mount is no mount: with ν = 1000 the shaft's trajectory is the model's own
+    /// (exact stick/slip, adaptive steps) within a small fraction of the swing, with dry
+    /// friction and drag: a free decay from over the top to rest, and a weakly forced swing
+    /// (both regular, so trajectories can be compared point by point).
+    #[test]
+    fn a_stiff_mount_follows_the_models_own_simulator() {
+        let p = Physical::default();
+        let mut weak = p.to_dimensionless();
+        weak.r *= 0.3;
+        for (model, y0) in [
+            (free(p.to_dimensionless()), [0.0, 2.5]),
+            (Model::new(weak), [0.6, 0.0]),
+        ] {
+            let (theta, worst) = compare(&model, y0, 1000.0);
+            let swing = theta.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            assert!(
+                worst < 1e-3 * swing,
+                "worst {worst} rad of a {swing} rad swing"
+            );
+            // And a soft mount is not: the same start moves the shaft differently.
+            let (_, apart) = compare(&model, y0, 3.0);
+            assert!(apart > 30.0 * worst, "soft {apart} vs stiff {worst}");
+        }
+    }
+
+    /// The model's own trajectory from y0 over 100 (per ω0), and the largest distance of the
+    /// bouncing bob's (mount ν, damping 0.3) from it.
+    fn compare(model: &Model, y0: [f64; 2], nu: f64) -> (Vec<f64>, f64) {
+        let reference =
+            simulate(model, &SimOptions::with_tol(1e-11), y0, 0.0, 100.0, 0.25).unwrap();
+        let mut got = Vec::new();
+        integrate(
+            model,
+            Mount { nu, zeta: 0.3 },
+            0.0,
+            y0,
+            100.0,
+            reference.t.iter().copied(),
+            |s| {
+                got.push(s.theta);
+                ControlFlow::Continue(())
+            },
+        );
+        assert_eq!(got.len(), reference.theta.len());
+        let worst = got
+            .iter()
+            .zip(&reference.theta)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        (reference.theta, worst)
+    }
+}
