@@ -2122,6 +2122,7 @@ pub fn discover(
         // catalogue entry a partial explanation of a departure it does not describe.
         let partial = crate::sparse::family_beats_candidate(
             &view.id_rows,
+            &view.val_rows,
             &current_cols,
             &cols,
             crate::sparse::family_of(&c.effect),
@@ -2689,7 +2690,20 @@ pub fn discover(
                 crate::sparse::library_values(r.theta, r.theta_dot_rad_s, r.phase, r.tau_s, a_y)
             })
             .collect();
-        crate::sparse::describe(&view.weak, &final_res, &lib, &nuisance, &id_mask, &centre)
+        let describe = |without: &[&str]| {
+            crate::sparse::describe(
+                &view.weak, &final_res, &lib, &nuisance, &id_mask, &centre, without,
+            )
+        };
+        match describe(&[]) {
+            Some(d)
+                if d.uses_any(&crate::sparse::CONFIRMED_ONLY)
+                    && d.heldout_gain <= cfg.eq_gain_min.max(d.heldout_noise) =>
+            {
+                describe(&crate::sparse::CONFIRMED_ONLY)
+            }
+            other => other,
+        }
     };
     let confirmed_description = description
         .as_ref()
