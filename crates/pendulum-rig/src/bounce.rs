@@ -77,9 +77,29 @@ fn step(model: &Model, m: Mount, t_end: f64) -> f64 {
     h
 }
 
-/// Integrates from (θ0, θ'0) with the bob at rest on its mount (ρ = 1, ρ' = 0) over [t0, t_end],
-/// handing `sink` the shaft's (θ, θ') at each of `times` (ascending, in [t0, t_end]) by cubic
-/// Hermite interpolation within a classic fourth-order Runge–Kutta step.
+/// One classic fourth-order Runge–Kutta step of `h` from (t, y), whose slope there is `k1`.
+fn rk4(model: &Model, mount: Mount, t: f64, y: &State, k1: &State, h: f64) -> State {
+    let at = |k: &State, a: f64| -> State {
+        [
+            y[0] + a * k[0],
+            y[1] + a * k[1],
+            y[2] + a * k[2],
+            y[3] + a * k[3],
+        ]
+    };
+    let k2 = rhs(model, mount, t + 0.5 * h, at(k1, 0.5 * h));
+    let k3 = rhs(model, mount, t + 0.5 * h, at(&k2, 0.5 * h));
+    let k4 = rhs(model, mount, t + h, at(&k3, h));
+    let mut out = *y;
+    for i in 0..4 {
+        out[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
+    }
+    out
+}
+
+/// Integrates from (θ0, θ'0) with the bob at rest on its mount (ρ = 1, ρ' = 0) over [t0, t_end]
+/// on a uniform grid of fourth-order Runge–Kutta steps, handing `sink` the shaft's (θ, θ') at
+/// each of `times` (ascending, in [t0, t_end]) by a partial step from the grid point before it.
 pub fn integrate<I, F>(
     model: &Model,
     mount: Mount,
@@ -98,45 +118,16 @@ pub fn integrate<I, F>(
     let mut f = rhs(model, mount, t, y);
     for tq in times {
         while t + h < tq {
-            let k1 = f;
-            let at = |y: &State, k: &State, a: f64| -> State {
-                [
-                    y[0] + a * k[0],
-                    y[1] + a * k[1],
-                    y[2] + a * k[2],
-                    y[3] + a * k[3],
-                ]
-            };
-            let k2 = rhs(model, mount, t + 0.5 * h, at(&y, &k1, 0.5 * h));
-            let k3 = rhs(model, mount, t + 0.5 * h, at(&y, &k2, 0.5 * h));
-            let k4 = rhs(model, mount, t + h, at(&y, &k3, h));
-            for i in 0..4 {
-                y[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
-            }
+            y = rk4(model, mount, t, &y, &f, h);
             t += h;
             f = rhs(model, mount, t, y);
         }
         // The last partial step to tq, taken on a copy (the grid stays uniform).
         let dt = tq - t;
-        let (theta, w) = if dt <= 0.0 {
-            (y[0], y[1])
+        let [theta, w, _, _] = if dt <= 0.0 {
+            y
         } else {
-            let k1 = f;
-            let at = |k: &State, a: f64| -> State {
-                [
-                    y[0] + a * k[0],
-                    y[1] + a * k[1],
-                    y[2] + a * k[2],
-                    y[3] + a * k[3],
-                ]
-            };
-            let k2 = rhs(model, mount, t + 0.5 * dt, at(&k1, 0.5 * dt));
-            let k3 = rhs(model, mount, t + 0.5 * dt, at(&k2, 0.5 * dt));
-            let k4 = rhs(model, mount, t + dt, at(&k3, dt));
-            (
-                y[0] + dt / 6.0 * (k1[0] + 2.0 * k2[0] + 2.0 * k3[0] + k4[0]),
-                y[1] + dt / 6.0 * (k1[1] + 2.0 * k2[1] + 2.0 * k3[1] + k4[1]),
-            )
+            rk4(model, mount, t, &y, &f, dt)
         };
         if sink(Sample {
             t: tq,
@@ -183,7 +174,7 @@ mod tests {
                 + y[2]
                 + 0.5 * mount.nu * mount.nu * (y[2] - 1.0).powi(2)
         };
-        // The state along the way, integrated by hand with the module's step.
+        // The state along the way, stepped with the module's own step and size.
         let h = step(&model, mount, 50.0);
         let mut y: State = [0.0, 2.3, 1.0, 0.0];
         let e0 = energy(&y);
@@ -191,20 +182,7 @@ mod tests {
         let mut rho_max = 1.0f64;
         while t < 50.0 {
             let k1 = rhs(&model, mount, t, y);
-            let at = |k: &State, a: f64| {
-                [
-                    y[0] + a * k[0],
-                    y[1] + a * k[1],
-                    y[2] + a * k[2],
-                    y[3] + a * k[3],
-                ]
-            };
-            let k2 = rhs(&model, mount, t + 0.5 * h, at(&k1, 0.5 * h));
-            let k3 = rhs(&model, mount, t + 0.5 * h, at(&k2, 0.5 * h));
-            let k4 = rhs(&model, mount, t + h, at(&k3, h));
-            for i in 0..4 {
-                y[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
-            }
+            y = rk4(&model, mount, t, &y, &k1, h);
             t += h;
             rho_max = rho_max.max(y[2]);
         }
