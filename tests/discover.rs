@@ -497,19 +497,27 @@ fn a_dry_torque_is_not_credited_with_what_a_better_start_gives_the_base() {
 /// states, shaped by the missing offset, it preferred a = 0.95 and b = 0.98 to the truth, just
 /// inside their bound. From the initial states the model follows, the truth scores E_θ 0.32
 /// against 14.4 and the refit stays near it.)
-fn offset_mistaken_for_sticking() -> (f64, DiscoverSummary) {
-    let off = 100_000;
-    let e_idx = 8; // encoder_offset's place in the survey's order
-    let (truth, spec, base, a, b, mu) = draw("encoder_offset", &mut rng(1000 + 100 * e_idx + off));
-    (
-        truth,
-        discover(5000 + 100 * e_idx + off, base, a, b, mu, &spec),
-    )
+///
+/// Run once for the two tests that read it (a discover costs ~40 s of CPU; the suite's time is
+/// kept under CI's 15 minutes).
+fn offset_mistaken_for_sticking() -> &'static (f64, DiscoverSummary) {
+    static CASE: std::sync::OnceLock<(f64, DiscoverSummary)> = std::sync::OnceLock::new();
+    CASE.get_or_init(|| {
+        let off = 100_000;
+        let e_idx = 8; // encoder_offset's place in the survey's order
+        let (truth, spec, base, a, b, mu) =
+            draw("encoder_offset", &mut rng(1000 + 100 * e_idx + off));
+        (
+            truth,
+            discover(5000 + 100 * e_idx + off, base, a, b, mu, &spec),
+        )
+    })
 }
 
 #[test]
 fn an_offset_the_base_fit_mistakes_for_sticking_is_named_on_the_second_look() {
     let (truth, s) = offset_mistaken_for_sticking();
+    let truth = *truth;
     assert_eq!(s.discovery.accepted(), ["encoder_offset"]);
     assert!(
         s.discovery.unexplained.is_none(),
@@ -540,6 +548,35 @@ fn an_offset_the_base_fit_mistakes_for_sticking_is_named_on_the_second_look() {
 #[test]
 fn an_offset_the_base_fit_mistakes_for_sticking_is_named_within_two_mrad() {
     let (truth, s) = offset_mistaken_for_sticking();
+    let truth = *truth;
+    let row = s.discovery.row("encoder_offset").unwrap();
+    assert!(
+        (row.estimate - truth).abs() < 2e-3,
+        "{} vs {truth}",
+        row.estimate
+    );
+}
+
+/// `encoder_offset` k = 2 of the every-effect survey at `SURVEY_SEED=3` (a draw first run in the
+/// fourteenth session, after every rule was set): a −0.070 rad offset. The offset, applied
+/// exactly to the measured motion, rebuilt the equation-error view, and on the corrected motion
+/// one identify run had no window left outside the sticking test, so the view held three
+/// per-run zeroing contrasts where the first had four; the columns chosen on the first view
+/// indexed past the rows and discover panicked. A corrected view now carries the columns over
+/// with its own contrasts, and the offset is named.
+#[test]
+fn an_offset_that_changes_which_runs_have_windows_does_not_break_the_screen() {
+    let off = 300_000;
+    let (e_idx, k) = (8, 2); // encoder_offset's place in the survey's order, and the draw
+    let (truth, spec, base, a, b, mu) =
+        draw("encoder_offset", &mut rng(1000 + 100 * e_idx + k + off));
+    let s = discover(5000 + 100 * e_idx + k + off, base, a, b, mu, &spec);
+    assert_eq!(
+        s.discovery.accepted(),
+        ["encoder_offset"],
+        "{:#?}",
+        s.discovery.rows
+    );
     let row = s.discovery.row("encoder_offset").unwrap();
     assert!(
         (row.estimate - truth).abs() < 2e-3,

@@ -195,6 +195,33 @@ struct View {
 }
 
 impl View {
+    /// `cols`, chosen on the view `from`, in this view: the same catalogue columns, with `from`'s
+    /// per-run zeroing-error contrasts replaced by this view's own. A correction rebuilds the
+    /// view, and can change which identify runs have rows (an encoder offset moves windows in
+    /// or out of the sticking test), so the number of contrasts (a survey campaign's 4 became 3,
+    /// and the old indices ran past the rows). Unchanged when the contrasts are the same.
+    fn columns_from(&self, cols: &[usize], from: &View) -> Vec<usize> {
+        if self.zero_cols == from.zero_cols {
+            return cols.to_vec();
+        }
+        let at = cols
+            .iter()
+            .position(|c| from.zero_cols.contains(c))
+            .unwrap_or(cols.len());
+        let kept: Vec<usize> = cols
+            .iter()
+            .copied()
+            .filter(|c| !from.zero_cols.contains(c))
+            .collect();
+        let at = at.min(kept.len());
+        kept[..at]
+            .iter()
+            .chain(&self.zero_cols)
+            .chain(&kept[at..])
+            .copied()
+            .collect()
+    }
+
     fn build(
         ctx: &Context,
         alignments: &std::collections::BTreeMap<String, pendulum_process::Alignment>,
@@ -1765,7 +1792,7 @@ pub fn discover(
         };
         let second_look = !matches!(second, SecondLook::NotStarted);
         let c = &sc.candidate;
-        let cols = with_candidate(&current_cols, c);
+        let mut cols = with_candidate(&current_cols, c);
         if let Some(sh) = c.shaped() {
             view.set_shape(sh.col, c.shape);
         }
@@ -1790,7 +1817,7 @@ pub fn discover(
             for _ in 0..3 {
                 set(&mut corr, est);
                 let v = View::build(ctx, &weak_ctx.alignments, base, &cfg.weak, &corr);
-                let Some(f2) = ols(&v.id_rows, &cols) else {
+                let Some(f2) = ols(&v.id_rows, &v.columns_from(&cols, &view)) else {
                     break;
                 };
                 // The corrected view's column holds what is left of the effect.
@@ -2399,11 +2426,13 @@ pub fn discover(
         // to (the view and its correction here, before a provisional hold changes them).
         let pair_view = pair_start
             .as_ref()
-            .map(|_| (view.clone(), correction.clone()));
+            .map(|_| (view.clone(), correction.clone(), current_cols.clone()));
         // Accepted, or held provisionally as the pair look's first candidate.
         let take = accepted || pair_start.is_some();
         if take {
             if let Some((v, corr)) = refined {
+                cols = v.columns_from(&cols, &view);
+                current_cols = v.columns_from(&current_cols, &view);
                 view = v;
                 correction = corr;
                 row.note.push_str(&format!(
@@ -2499,7 +2528,7 @@ pub fn discover(
             next = queue.pop_front();
         }
         if let Some((b, eq)) = pair_start {
-            let (v, corr) = pair_view.expect("taken with the pair look's start");
+            let (v, corr, saved_cols) = pair_view.expect("taken with the pair look's start");
             pair_tried = true;
             pair = Some(PairLook {
                 first: c.effect.clone(),
@@ -2511,7 +2540,7 @@ pub fn discover(
                     corr,
                     current.clone(),
                     current_val.clone(),
-                    current_cols.clone(),
+                    saved_cols,
                     baseline.clone(),
                     round,
                     queue.clone(),
