@@ -230,6 +230,7 @@ fn found_when_hidden(effect: &str, tag: u64, seed: u64) -> DiscoverSummary {
 }
 
 #[test]
+#[ignore = "slow set (one fixed twin draw with nothing hidden; the false-alarm survey draws 50): the default suite checks that nothing is named on independent::issue_12_independent_i00_none, i01 and i11 and in the twin regressions with nothing hidden; README, Tests"]
 fn regression_issue_5_nothing_hidden_nothing_named() {
     let s = discover(105, Base::Reference, 0.0, 0.5, 0.15, "");
     let accepted = s.discovery.accepted();
@@ -664,7 +665,7 @@ fn assert_pair_found(tag: u64, seed: u64, e1: &str, e2: &str) -> DiscoverSummary
 
 /// A pair: two effects hidden together must both be named (and nothing else).
 #[test]
-#[ignore = "slow set (one fixed twin draw of a pair): the default suite names pairs on independent::issue_12_independent_i10_pair and in the lag-and-tilt and offset-and-inertia tests; README, Tests"]
+#[ignore = "slow set (one fixed twin draw of a pair): the default suite names pairs on independent::issue_12_independent_i10_pair and in the lag-and-tilt test; README, Tests"]
 fn regression_issue_5_finds_a_pair() {
     assert_pair_found(13, 157, "horizontal_base", "extra_inertia");
 }
@@ -688,6 +689,7 @@ fn a_lag_and_a_tilt_that_each_spoil_the_others_held_out_views_are_named_as_a_pai
 /// A large encoder offset's linearised remainder (θ_off²/2 · sin θ) looks like extra inertia: the
 /// offset must be applied exactly before the inertia is judged (it was −12 % off before).
 #[test]
+#[ignore = "slow set (the every-effect survey's third pair, one draw): the default suite names pairs on independent::issue_12_independent_i10_pair and in the lag-and-tilt test, and an offset on independent::issue_12_independent_i06_encoder_offset; README, Tests"]
 fn regression_issue_5_finds_offset_and_inertia_together() {
     assert_pair_found(3002, 7002, "encoder_offset", "extra_inertia");
 }
@@ -1764,7 +1766,7 @@ fn regression_issue_12_forcing_not_understood_is_flagged() {
 
 /// The survey's fourth pair: a constant dry torque beside a tilted guide.
 #[test]
-#[ignore = "slow set (the every-effect survey's fourth pair, one draw): the default suite names pairs on independent::issue_12_independent_i10_pair and in the lag-and-tilt and offset-and-inertia tests; README, Tests"]
+#[ignore = "slow set (the every-effect survey's fourth pair, one draw): the default suite names pairs on independent::issue_12_independent_i10_pair and in the lag-and-tilt test; README, Tests"]
 fn regression_issue_12_finds_dry_torque_and_tilt_together() {
     assert_pair_found(3003, 7003, "coulomb_constant", "horizontal_base");
 }

@@ -34,15 +34,28 @@ pub fn make_campaign(dir: &Path, toml: &str) -> TwinTruthFile {
 }
 
 fn identify(dir: &Path, out: &Path, model: &str) -> pendulum_jobs::outputs::OutputSummary {
-    run(&IdentifyJob {
-        input: dir.to_path_buf(),
-        out: out.to_path_buf(),
-        pipeline: None,
-        overrides: FitOverrides {
+    identify_with(
+        dir,
+        out,
+        FitOverrides {
             model: Some(model.into()),
             generations: Some(1000),
             ..FitOverrides::default()
         },
+    )
+}
+
+/// `pendulum identify` of `dir` into `out` with `overrides`.
+fn identify_with(
+    dir: &Path,
+    out: &Path,
+    overrides: FitOverrides,
+) -> pendulum_jobs::outputs::OutputSummary {
+    run(&IdentifyJob {
+        input: dir.to_path_buf(),
+        out: out.to_path_buf(),
+        pipeline: None,
+        overrides,
         progress: false,
         free_segments: false,
     })
@@ -399,7 +412,16 @@ fn a_run_that_cannot_be_aligned_is_left_out_not_the_campaign() {
     flatten(&csvs[0]);
     let bad = csvs[0].file_stem().unwrap().to_str().unwrap().to_string();
     let out = dir.path().join("out");
-    let s = identify(&camp, &out, "reference");
+    // Which runs are fitted is what is tested, not how well: a short fit.
+    let s = identify_with(
+        &camp,
+        &out,
+        FitOverrides {
+            model: Some("reference".into()),
+            generations: Some(40),
+            ..FitOverrides::default()
+        },
+    );
     let text = s.to_string();
     assert!(
         text.contains(&format!(
@@ -449,9 +471,13 @@ fn a_run_that_cannot_be_aligned_is_left_out_not_the_campaign() {
 /// campaign gave μ = 0.24999 at f_obj 8.04; widened, μ = 0.393 at 5.13). With this much
 /// friction four of the five identify runs come to rest, so μ is known only to about a tenth:
 /// the test asks that it be clearly past the old range and nearer the truth than the old bound
-/// was, and b within 10 %.
+/// was, and b within 10 %. Run with a third of the pipeline's population (44 members for 13
+/// variables, not 130; it cost 77 s of the suite): the widening is what is tested, and the
+/// smaller population reaches the bound in a third of the evaluations. Measured (on 01d5b8e's
+/// analysis): two rounds, 2001 generations, μ = 0.395, b = 0.478 at f_obj 5.08.
 #[test]
 fn damping_past_the_studys_search_range_is_fitted_not_pinned() {
+    const NP: usize = 44;
     let dir = tempfile::tempdir().unwrap();
     let camp = dir.path().join("campaign");
     let out = dir.path().join("out");
@@ -459,7 +485,16 @@ fn damping_past_the_studys_search_range_is_fitted_not_pinned() {
         &camp,
         &pendulum_jobs::demo::discovery_campaign("wide", 61, 0.0, 0.5, 0.35, ""),
     );
-    let summary = identify(&camp, &out, "reference");
+    let summary = identify_with(
+        &camp,
+        &out,
+        FitOverrides {
+            model: Some("reference".into()),
+            generations: Some(1000),
+            np: Some(NP),
+            ..FitOverrides::default()
+        },
+    );
     eprintln!("{summary}");
     let (a, b, mu) = reference_params(&out);
     assert!(
