@@ -3,6 +3,11 @@
 //! tuned (in this same run) to reach at least the same accuracy against a 1e-13 reference.
 //!
 //! Run: `cargo bench --bench simulator`. Prints ratios; asserts nothing about time.
+//!
+//! `cargo bench --bench simulator -- bounce`: the twin's bouncing bob (`pendulum_rig::bounce`),
+//! forcing periods per second with its coarse steps while the shaft moves against the fine step
+//! everywhere (the baseline, as before the coarse steps), on the rotating and the oscillating
+//! case on a 5 Hz mount, and the largest distance between the two trajectories.
 
 use std::hint::black_box;
 use std::ops::ControlFlow;
@@ -63,6 +68,48 @@ fn time_it<F: FnMut()>(mut f: F, min_s: f64) -> f64 {
     start.elapsed().as_secs_f64() / n as f64
 }
 
+/// Periods per second of the bouncing bob's integrator with coarse steps and with the fine step
+/// everywhere, over `periods` forcing periods from `y0`, and the largest |Δθ| between them.
+fn bounce_case(model: &Model, y0: [f64; 2], periods: f64) {
+    use pendulum_rig::bounce::{integrate, integrate_fine_everywhere, Mount};
+    let omega = model.params.omega;
+    let t_end = periods * 2.0 * std::f64::consts::PI / omega;
+    // A 5 Hz mount on the study's pendulum (ω0 ≈ 6.1 rad/s).
+    let mount = Mount {
+        nu: 2.0 * std::f64::consts::PI * 5.0 / 6.1,
+        zeta: 0.1,
+    };
+    let times = || (0..=1000).map(move |i| t_end * f64::from(i) / 1000.0);
+    let run = |fine: bool| {
+        let mut th = Vec::with_capacity(1001);
+        let sink = |s: pendulum_model::Sample| {
+            th.push(s.theta);
+            ControlFlow::Continue(())
+        };
+        if fine {
+            integrate_fine_everywhere(model, mount, 0.0, y0, t_end, times(), sink);
+        } else {
+            integrate(model, mount, 0.0, y0, t_end, times(), sink);
+        }
+        th
+    };
+    let (a, b) = (run(false), run(true));
+    let apart = a
+        .iter()
+        .zip(&b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max);
+    let t_coarse = time_it(|| drop(black_box(run(false))), 1.0);
+    let t_fine = time_it(|| drop(black_box(run(true))), 1.0);
+    println!(
+        "{:>8.0}  {:>12.0}  {:>12.0}  {:>8.1}  {apart:.1e}",
+        periods,
+        periods / t_coarse,
+        periods / t_fine,
+        t_fine / t_coarse
+    );
+}
+
 fn main() {
     let mut d = Dimensionless::conservative();
     d.r = 0.7;
@@ -74,6 +121,21 @@ fn main() {
         ("rotating", 1.585, |c| c.is_rotation()),
         ("oscillating", 2.0, |c| c == SteadyClass::Oscillation),
     ];
+    if std::env::args().any(|a| a == "bounce") {
+        println!("case         periods  coarse [periods/s]  fine [periods/s]  fine/coarse  max |Δθ| [rad]");
+        for (name, omega, want) in cases {
+            let mut p = d;
+            p.omega = omega;
+            let model = Model::new(p);
+            let Some(y0) = attractor(&model, want) else {
+                println!("{name:<12} no such attractor found on the start grid");
+                continue;
+            };
+            print!("{name:<12} ");
+            bounce_case(&model, y0, 20.0);
+        }
+        return;
+    }
     println!("case         periods  dopri5@1e-8 [periods/s]  err      rk4 h     err      rk4 [periods/s]  dopri5/rk4");
     for (name, omega, want) in cases {
         let mut p = d;
