@@ -71,7 +71,7 @@ fn time_it<F: FnMut()>(mut f: F, min_s: f64) -> f64 {
 /// Periods per second of the bouncing bob's integrator with coarse steps and with the fine step
 /// everywhere, over `periods` forcing periods from `y0`, and the largest |Δθ| between them.
 fn bounce_case(model: &Model, y0: [f64; 2], periods: f64) {
-    use pendulum_rig::bounce::{integrate, integrate_fine_everywhere, Mount};
+    use pendulum_rig::bounce::{integrate, Mount, Steps};
     let omega = model.params.omega;
     let t_end = periods * 2.0 * std::f64::consts::PI / omega;
     // A 5 Hz mount on the study's pendulum (ω0 ≈ 6.1 rad/s).
@@ -86,11 +86,12 @@ fn bounce_case(model: &Model, y0: [f64; 2], periods: f64) {
             th.push(s.theta);
             ControlFlow::Continue(())
         };
-        if fine {
-            integrate_fine_everywhere(model, mount, 0.0, y0, t_end, times(), sink);
+        let steps = if fine {
+            Steps::FineEverywhere
         } else {
-            integrate(model, mount, 0.0, y0, t_end, times(), sink);
-        }
+            Steps::Adaptive
+        };
+        integrate(model, mount, steps, 0.0, y0, t_end, times(), sink);
         th
     };
     let (a, b) = (run(false), run(true));
@@ -121,22 +122,12 @@ fn main() {
         ("rotating", 1.585, |c| c.is_rotation()),
         ("oscillating", 2.0, |c| c == SteadyClass::Oscillation),
     ];
-    if std::env::args().any(|a| a == "bounce") {
+    let bounce = std::env::args().any(|a| a == "bounce");
+    if bounce {
         println!("case         periods  coarse [periods/s]  fine [periods/s]  fine/coarse  max |Δθ| [rad]");
-        for (name, omega, want) in cases {
-            let mut p = d;
-            p.omega = omega;
-            let model = Model::new(p);
-            let Some(y0) = attractor(&model, want) else {
-                println!("{name:<12} no such attractor found on the start grid");
-                continue;
-            };
-            print!("{name:<12} ");
-            bounce_case(&model, y0, 20.0);
-        }
-        return;
+    } else {
+        println!("case         periods  dopri5@1e-8 [periods/s]  err      rk4 h     err      rk4 [periods/s]  dopri5/rk4");
     }
-    println!("case         periods  dopri5@1e-8 [periods/s]  err      rk4 h     err      rk4 [periods/s]  dopri5/rk4");
     for (name, omega, want) in cases {
         let mut p = d;
         p.omega = omega;
@@ -145,6 +136,11 @@ fn main() {
             println!("{name:<12} no such attractor found on the start grid");
             continue;
         };
+        if bounce {
+            print!("{name:<12} ");
+            bounce_case(&model, y0, 20.0);
+            continue;
+        }
         let periods = 20.0;
         let t_end = periods * p.forcing_period();
         let reference = end_state(&model, 1e-13, y0, t_end);

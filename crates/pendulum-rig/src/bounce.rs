@@ -119,62 +119,40 @@ fn rk4(model: &Model, mount: Mount, t: f64, y: &State, k1: &State, h: f64) -> St
     out
 }
 
+/// How [`integrate`] steps away from the friction's linear zone.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Steps {
+    /// Coarse while the shaft moves, fine near and in the zone (`step_at`): the twin's.
+    Adaptive,
+    /// The fine step everywhere, as the twin integrated before the coarse steps: the reference
+    /// they are checked against (a test, and `cargo bench --bench simulator -- bounce`). Its step
+    /// is 1.5 V_EPS over the largest dry torque: with the surveys' μ ≈ 0.15 about 300 times
+    /// fewer per unit time than a moving shaft needs; the bench's lighter friction, 14×.
+    FineEverywhere,
+}
+
 /// Integrates from (θ0, θ'0) with the bob at rest on its mount (ρ = 1, ρ' = 0) over [t0, t_end]
-/// in fourth-order Runge–Kutta steps ([`step_at`]: coarse while the shaft moves, fine near and in
-/// the friction's linear zone), handing `sink` the shaft's (θ, θ') at each of `times`
-/// (ascending, in [t0, t_end]) by a partial step from the step's start before it.
+/// in fourth-order Runge–Kutta steps (`steps`), handing `sink` the shaft's (θ, θ') at each of
+/// `times` (ascending, in [t0, t_end]) by a partial step from the step's start before it.
+#[allow(clippy::too_many_arguments)]
 pub fn integrate<I, F>(
     model: &Model,
     mount: Mount,
-    t0: f64,
-    y0: [f64; 2],
-    t_end: f64,
-    times: I,
-    sink: F,
-) where
-    I: IntoIterator<Item = f64>,
-    F: FnMut(Sample) -> ControlFlow<()>,
-{
-    let coarse = coarse_step(model, mount);
-    integrate_in(model, mount, t0, y0, t_end, times, sink, coarse);
-}
-
-/// [`integrate`] with the fine step everywhere, as the twin integrated before the coarse steps:
-/// the reference they are checked against (a test, and `cargo bench --bench simulator --
-/// bounce`). Its step is 1.5 V_EPS over the largest dry torque: with the surveys' μ ≈ 0.15 about
-/// 300 times fewer per unit time than a moving shaft needs; the bench's lighter friction, 14×.
-pub fn integrate_fine_everywhere<I, F>(
-    model: &Model,
-    mount: Mount,
-    t0: f64,
-    y0: [f64; 2],
-    t_end: f64,
-    times: I,
-    sink: F,
-) where
-    I: IntoIterator<Item = f64>,
-    F: FnMut(Sample) -> ControlFlow<()>,
-{
-    let fine = step(model, mount, t_end);
-    integrate_in(model, mount, t0, y0, t_end, times, sink, fine);
-}
-
-/// The integration with `coarse` as the step away from the friction's zone.
-#[allow(clippy::too_many_arguments)]
-fn integrate_in<I, F>(
-    model: &Model,
-    mount: Mount,
+    steps: Steps,
     t0: f64,
     y0: [f64; 2],
     t_end: f64,
     times: I,
     mut sink: F,
-    coarse: f64,
 ) where
     I: IntoIterator<Item = f64>,
     F: FnMut(Sample) -> ControlFlow<()>,
 {
     let fine = step(model, mount, t_end);
+    let coarse = match steps {
+        Steps::Adaptive => coarse_step(model, mount),
+        Steps::FineEverywhere => fine,
+    };
     let mut t = t0;
     let mut y: State = [y0[0], y0[1], 1.0, 0.0];
     let mut f = rhs(model, mount, t, y);
@@ -295,18 +273,36 @@ mod tests {
         let mount = Mount { nu: 3.0, zeta: 0.2 };
         let times = || (0..=4000).map(|i| 0.05 * f64::from(i));
         let mut got = Vec::new();
-        integrate(&model, mount, 0.0, [1.2, 0.0], 200.0, times(), |s| {
-            got.push(s.theta);
-            ControlFlow::Continue(())
-        });
+        integrate(
+            &model,
+            mount,
+            Steps::Adaptive,
+            0.0,
+            [1.2, 0.0],
+            200.0,
+            times(),
+            |s| {
+                got.push(s.theta);
+                ControlFlow::Continue(())
+            },
+        );
         let mut fine = Vec::new();
         // Samples in or near the friction's linear zone (stuck, or turning).
         let mut slow = 0usize;
-        integrate_fine_everywhere(&model, mount, 0.0, [1.2, 0.0], 200.0, times(), |s| {
-            fine.push(s.theta);
-            slow += usize::from(s.theta_dot.abs() < 100.0 * V_EPS);
-            ControlFlow::Continue(())
-        });
+        integrate(
+            &model,
+            mount,
+            Steps::FineEverywhere,
+            0.0,
+            [1.2, 0.0],
+            200.0,
+            times(),
+            |s| {
+                fine.push(s.theta);
+                slow += usize::from(s.theta_dot.abs() < 100.0 * V_EPS);
+                ControlFlow::Continue(())
+            },
+        );
         assert_eq!(got.len(), fine.len());
         let worst = got
             .iter()
@@ -328,6 +324,7 @@ mod tests {
         integrate(
             model,
             Mount { nu, zeta: 0.3 },
+            Steps::Adaptive,
             0.0,
             y0,
             100.0,

@@ -793,6 +793,7 @@ fn synthesize_run(
                     .bob_bounce_damping_ratio
                     .unwrap_or(0.05),
             },
+            crate::bounce::Steps::Adaptive,
             0.0,
             y0,
             t_end,
