@@ -265,6 +265,23 @@ mod tests {
         d
     }
 
+    /// The shaft's samples at `times` from (θ0, θ'0) = `y0` at t = 0 to `t_end`.
+    fn trace(
+        model: &Model,
+        mount: Mount,
+        steps: Steps,
+        y0: [f64; 2],
+        t_end: f64,
+        times: impl IntoIterator<Item = f64>,
+    ) -> Vec<Sample> {
+        let mut got = Vec::new();
+        integrate(model, mount, steps, 0.0, y0, t_end, times, |s| {
+            got.push(s);
+            ControlFlow::Continue(())
+        });
+        got
+    }
+
     /// Without losses the mount's energy ½(ρ'² + ρ²θ'²) − ρ cos θ + ρ + ½ν²(ρ − 1)² is kept:
     /// the conservation law the equations come from, checked on a swing that stretches the mount
     /// (over the top: the centrifugal load pulls the bob out).
@@ -333,37 +350,24 @@ mod tests {
         let model = Model::new(d);
         let mount = Mount { nu: 3.0, zeta: 0.2 };
         let times = || (0..=4000).map(|i| 0.05 * f64::from(i));
-        let mut got = Vec::new();
-        integrate(
-            &model,
-            mount,
-            Steps::Adaptive,
-            0.0,
-            [1.2, 0.0],
-            200.0,
-            times(),
-            |s| {
-                got.push(s.theta);
-                ControlFlow::Continue(())
-            },
-        );
-        let mut fine = Vec::new();
-        // Samples in or near the friction's linear zone (stuck, or turning).
-        let mut slow = 0usize;
-        integrate(
+        let got: Vec<f64> = trace(&model, mount, Steps::Adaptive, [1.2, 0.0], 200.0, times())
+            .iter()
+            .map(|s| s.theta)
+            .collect();
+        let fine_run = trace(
             &model,
             mount,
             Steps::FineEverywhere,
-            0.0,
             [1.2, 0.0],
             200.0,
             times(),
-            |s| {
-                fine.push(s.theta);
-                slow += usize::from(s.theta_dot.abs() < 100.0 * V_EPS);
-                ControlFlow::Continue(())
-            },
         );
+        let fine: Vec<f64> = fine_run.iter().map(|s| s.theta).collect();
+        // Samples in or near the friction's linear zone (stuck, or turning).
+        let slow = fine_run
+            .iter()
+            .filter(|s| s.theta_dot.abs() < 100.0 * V_EPS)
+            .count();
         assert_eq!(got.len(), fine.len());
         let worst = got
             .iter()
@@ -393,32 +397,20 @@ mod tests {
         let cap = model.static_balance(0.0, 0.0).1;
         let theta0 = (0.2 * cap).asin();
         let run = |theta0: f64| {
-            let mut got = Vec::new();
-            integrate(
-                &model,
-                mount,
-                Steps::Adaptive,
-                0.0,
-                [theta0, 0.0],
-                100.0,
-                (0..=1000).map(|i| 0.1 * f64::from(i)),
-                |s| {
-                    got.push((s.theta, s.theta_dot));
-                    ControlFlow::Continue(())
-                },
-            );
-            got
+            let times = (0..=1000).map(|i| 0.1 * f64::from(i));
+            trace(&model, mount, Steps::Adaptive, [theta0, 0.0], 100.0, times)
         };
         let held = run(theta0);
         assert_eq!(held.len(), 1001);
         assert!(
-            held.iter().all(|&(th, w)| th == theta0 && w == 0.0),
+            held.iter().all(|s| s.theta == theta0 && s.theta_dot == 0.0),
             "moved: {:?}",
-            held.iter().find(|&&(th, w)| th != theta0 || w != 0.0)
+            held.iter()
+                .find(|s| s.theta != theta0 || s.theta_dot != 0.0)
         );
         let far = (2.0 * cap).asin();
         let slipped = run(far);
-        assert!(slipped.iter().any(|&(th, _)| (th - far).abs() > 1e-3 * far));
+        assert!(slipped.iter().any(|s| (s.theta - far).abs() > 1e-3 * far));
     }
 
     /// The model's own trajectory from y0 over 100 (per ω0), and the largest distance of the
@@ -426,20 +418,17 @@ mod tests {
     fn compare(model: &Model, y0: [f64; 2], nu: f64) -> (Vec<f64>, f64) {
         let reference =
             simulate(model, &SimOptions::with_tol(1e-11), y0, 0.0, 100.0, 0.25).unwrap();
-        let mut got = Vec::new();
-        integrate(
+        let got: Vec<f64> = trace(
             model,
             Mount { nu, zeta: 0.3 },
             Steps::Adaptive,
-            0.0,
             y0,
             100.0,
             reference.t.iter().copied(),
-            |s| {
-                got.push(s.theta);
-                ControlFlow::Continue(())
-            },
-        );
+        )
+        .iter()
+        .map(|s| s.theta)
+        .collect();
         assert_eq!(got.len(), reference.theta.len());
         let worst = got
             .iter()
