@@ -624,9 +624,9 @@ fn a_growing_dry_torque_is_not_credited_with_the_damping_its_refit_repairs() {
 /// A cable anchored 0.50 rad off the hanging position (a 0.103 N·m/rad spring −κ(θ − θ_a),
 /// the departure survey's draw 0 at `DEPARTURE_SEED=3`) shifts the rest angle as an encoder
 /// offset would, and was named a −0.016 rad `encoder_offset` on the second look (E_θ fall
-/// 32 % ± 5 %, the validate runs' equation error rising 7.5 %), while a spring in the unwrapped
-/// θ took 89 % off that equation error. An offset is a torque that follows the angle, so the
-/// freer shape there makes it a partial explanation: nothing named, the words speak of θ.
+/// 32 % ± 5 %, freeing the pinned base) while the validate runs' equation error rose 7.5 %
+/// (noise 5.7 %) and a spring in the unwrapped θ took 89 % off it. Freeing the base stands in
+/// for that view's confirmation, not against it: nothing named, the words speak of θ.
 #[test]
 fn a_cable_anchored_off_the_vertical_is_not_named_an_encoder_offset() {
     let words = named_nothing_and_said("anchored_cable", 0, 300_000);

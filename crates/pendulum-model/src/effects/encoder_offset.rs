@@ -1,6 +1,6 @@
 //! `encoder_offset`: the count was zeroed away from the hanging position.
 
-use super::{Draw, Effect, Kind, Param, Regressor, Sensors, Survey, Tolerance, Variable};
+use super::{Draw, Effect, Kind, Param, Regressor, Sensors, Survey, Tolerance};
 
 #[derive(Debug)]
 pub struct EncoderOffset;
@@ -35,15 +35,6 @@ impl Effect for EncoderOffset {
     /// Within half a turn: an offset beyond it is another zero, not an offset.
     fn possible(&self, size: f64) -> bool {
         size.abs() < std::f64::consts::PI
-    }
-    /// In the equation of motion an offset is a torque that follows the angle, (1 + A_y) cos θ
-    /// to first order, so a freer shape in θ that does clearly better makes it a partial
-    /// explanation: a cable anchored 0.5 rad off the hanging position (a spring, −κ(θ − θ_a),
-    /// whose constant part shifts the rest angle as an offset would) was named a −0.016 rad
-    /// offset on an E_θ fall of 32 % ± 5 %, the validate runs' equation error rising 7.5 %,
-    /// while a spring in the unwrapped θ took 89 % off it.
-    fn follows(&self) -> &'static [Variable] {
-        &[Variable::Angle, Variable::AngleInTurn]
     }
     fn regressors(&self) -> &'static [Regressor] {
         &REGRESSORS
