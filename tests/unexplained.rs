@@ -240,6 +240,7 @@ fn encoder_backlash_is_unexplained_and_follows_the_rate() {
 /// nothing named on either; one came back `unexplained` (`coulomb_constant` explains only 59 %
 /// of the freer shape in θ̇), the other with nothing said.
 #[test]
+#[ignore = "slow set (two fixed twin draws; the departure survey draws five): the default suite checks the same on a third draw, a_friction_that_differs_from_run_to_run_is_not_named_a_constant_dry_torque (nothing named, the words say the torque follows the run); README, Tests"]
 fn friction_that_differs_from_run_to_run_names_nothing() {
     let mut r = rng(5);
     for case in 0..2 {
