@@ -195,6 +195,14 @@ struct View {
 }
 
 impl View {
+    /// Per row of `weak`: whether it is an identify run's.
+    fn identify_mask(&self) -> Vec<bool> {
+        self.weak
+            .iter()
+            .map(|r| self.weak_runs[r.run].1 == Role::Identify)
+            .collect()
+    }
+
     /// `cols`, chosen on the view `from`, in this view: the same catalogue columns, with `from`'s
     /// per-run zeroing-error contrasts replaced by this view's own. A correction rebuilds the
     /// view, and can change which identify runs have rows (an encoder offset moves windows in
@@ -2194,17 +2202,11 @@ pub fn discover(
                     .iter()
                     .map(|&col| f.coef_of(col).map_or(0.0, |v| v.0))
                     .collect();
-                let id_mask: Vec<bool> = view
-                    .weak
-                    .iter()
-                    .map(|r| view.weak_runs[r.run].1 == Role::Identify)
-                    .collect();
-                crate::sparse::run_spread(&view.weak, &res, &cols, &pooled, &id_mask).is_some_and(
-                    |sp| {
+                crate::sparse::run_spread(&view.weak, &res, &cols, &pooled, &view.identify_mask())
+                    .is_some_and(|sp| {
                         sp.heldout_gain
                             > SECOND_LOOK_GAIN_FACTOR * sp.heldout_noise.max(cfg.eq_gain_min)
-                    },
-                )
+                    })
             });
         let plausible = partial.is_none()
             && !runs_disagree
@@ -2739,11 +2741,7 @@ pub fn discover(
     let final_ols = ols(&view.id_rows, &current_cols).unwrap_or(base_ols.clone());
     let final_res = final_ols.residuals(&view.weak);
     let residual_final = view.matched_to(&view0, &final_res, cfg.weak.half_width_s);
-    let id_mask: Vec<bool> = view
-        .weak
-        .iter()
-        .map(|r| view.weak_runs[r.run].1 == Role::Identify)
-        .collect();
+    let id_mask = view.identify_mask();
     let pick = |f: &dyn Fn(&WeakRow) -> f64| -> (Vec<f64>, Vec<f64>) {
         view.weak
             .iter()
