@@ -342,7 +342,8 @@ fn pow_ctrl(x: f64, a: f64) -> f64 {
 const BREAK_MARGIN: f64 = 1e-10;
 
 #[inline]
-fn breaks_loose(q: f64, c: f64) -> bool {
+/// Whether an applied torque `q` breaks a stuck shaft loose against the static capacity `c`.
+pub fn breaks_loose(q: f64, c: f64) -> bool {
     q.abs() > c * (1.0 + BREAK_MARGIN) + 1e-14
 }
 

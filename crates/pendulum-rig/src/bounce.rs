@@ -22,6 +22,7 @@
 
 use std::ops::ControlFlow;
 
+use pendulum_model::sim::breaks_loose;
 use pendulum_model::{Model, Sample};
 
 /// Half-width of the regularised dry friction's linear zone in θ' (per ω0).
@@ -66,10 +67,8 @@ fn rhs(model: &Model, m: Mount, t: f64, y: State) -> State {
 
 /// [`rhs`] with the shaft stuck: θ held (θ' = θ'' = 0), the bob moving on its mount.
 fn rhs_stuck(model: &Model, m: Mount, t: f64, y: State) -> State {
-    let [theta, _, rho, rw] = y;
-    let (ay, ax) = model.excitation.accel(t);
-    let (s, c) = theta.sin_cos();
-    let racc = (1.0 + ay) * c - ax * s - 1.0 - m.nu * m.nu * (rho - 1.0) - 2.0 * m.zeta * m.nu * rw;
+    // The bob's radial equation at θ' = 0 (the shaft's own slope is set to zero).
+    let [_, _, rw, racc] = rhs(model, m, t, [y[0], 0.0, y[2], y[3]]);
     [0.0, 0.0, rw, racc]
 }
 
@@ -90,20 +89,17 @@ fn balance(model: &Model, t: f64, y: &State) -> (f64, f64) {
     (q, model.static_balance(t, y[0]).1)
 }
 
-/// Relative margin by which the torque must exceed the capacity to break loose (the model's
-/// simulator keeps one for the same reason: |Q| = C to rounding is not a slip).
-const BREAK_MARGIN: f64 = 1e-10;
-
-/// Whether the shaft is stuck after a step that ended at (t, y): a stuck shaft stays so while
-/// the torque on it is within the capacity; a moving one sticks (θ' set to 0) once it is inside
-/// the friction's linear zone with the torque within the capacity.
+/// Whether the shaft is stuck after a step that ended at (t, y): a stuck shaft stays so until
+/// the torque on it breaks it loose (the model's own test, [`breaks_loose`]); a moving one
+/// sticks (θ' set to 0) once it is inside the friction's linear zone with the torque within the
+/// capacity.
 fn sticks(model: &Model, t: f64, y: &mut State, stuck: bool) -> bool {
     if !stuck && y[1].abs() >= V_EPS {
         return false;
     }
     let (q, cap) = balance(model, t, y);
     let holds = if stuck {
-        q.abs() <= cap * (1.0 + BREAK_MARGIN)
+        !breaks_loose(q, cap)
     } else {
         q.abs() <= cap
     };
