@@ -968,6 +968,34 @@ fn a_lag_the_resting_identify_runs_cannot_size_is_named_at_the_screens_value() {
     );
 }
 
+/// The every-effect survey's sixth draws (`SURVEY_SEED=5`), `bearing_load_base_accel` k = 2: the
+/// bearing load carrying the base's acceleration (μ 0.192) on a design whose three validate runs
+/// all rest. The screen had μ at 0.194 (ΔBIC −250) and the validate runs confirmed it (E_θ −82 %
+/// ± 47 %, equation error −43.8 % against 34.1 % needed), but the trajectories cannot tell the
+/// switch from its absence, and its refit traded μ for b and a along a flat profile to 0.145
+/// (−25 %): compared with the screen's narrow interval, the views "disagreed". Silent
+/// trajectories hold the screen's value, for a switch as for a size.
+#[test]
+fn a_bearing_load_the_trajectories_cannot_tell_from_its_absence_is_named_at_the_screens_value() {
+    let truth = 0.19240198304886924;
+    let s = discover(
+        505_302,
+        Base::Reference,
+        0.0,
+        0.5,
+        truth,
+        "bearing_load_base_accel = true",
+    );
+    assert_found(&s, "bearing_load_base_accel", truth, 0.10, 0.0);
+    let row = s.discovery.row("bearing_load_base_accel").unwrap();
+    assert_eq!(row.estimate, row.screen_estimate, "{}", row.note);
+    assert!(
+        row.note.contains("cannot tell the switch from its absence"),
+        "{}",
+        row.note
+    );
+}
+
 /// The every-effect survey's other draws (`SURVEY_SEED=1`), `horizontal_base` k = 4: a
 /// −0.0787 rad tilt on a mixed design. The screen met the tilt before the runs' common zeroing
 /// error (a few counts, the rig's own), whose column (1 + A_y) cos θ shares the tilt's A_y cos θ:

@@ -1955,44 +1955,6 @@ pub fn discover(
             }
             _ => None,
         };
-        // Trajectories silent on a torque's or an inertia's size (no power, and the screen's
-        // value fits them as well as the refit's): the refit's size is then one point of a flat
-        // profile, and the model judged on the held-out runs carries the screen's value with
-        // the other terms refitted (`x_prof`), the one value both views accept. A 0.0130 N·m
-        // constant dry torque on a drawn design whose two moving identify runs share one bob
-        // (so T_c and μ·load cannot be told apart on them) was refitted at 0.0010 with μ 0.23,
-        // which the validate runs' lighter bobs rejected (held-out E_θ −70 %), while the
-        // screen, seeing every identify run's moving windows, had it at 0.0126.
-        // Not for a shaped effect: its screened size holds only at the shape the screen's
-        // profile chose, and that profile is blind where the shape acts (see `shape_start`); a
-        // breakaway carried at the screen's 5.5e-3 N·m (truth 9.8e-3) lost the held-out fall
-        // its refit had shown.
-        let silent =
-            run_zeros && c.shaped().is_none() && size_power == Some(false) && g_prof >= -n_prof;
-        // An input effect (the forcing's lag) on a design whose identify runs come to rest: their
-        // trajectories (hand-start transients, free segments) hardly feel the forcing's timing,
-        // and the refit of a lag is then one point of a flat profile, its value and even its
-        // sign set by where Nelder–Mead wandered. A hidden 5.87 ms lag screened at 5.82 ms
-        // [5.71, 5.94] was refused because its refit had drifted to 6.47 ms (+11 %, outside the
-        // 10 % band) while the profile through the screen's value fitted the trajectories as
-        // well (E_θ −0.02 % ± 2.6 %) and the refit set to 0 did no worse either; the validate
-        // runs' E_θ fell 89 % ± 42 % and their equation error 99.7 %. The trajectories' own
-        // interval then holds the screen's value, so the views agree, and the model judged on
-        // the held-out runs carries the screen's value (the other terms refitted). Its
-        // held-out bar stays the input effect's own (below), not `silent`'s both-views one: an
-        // input effect's equation-error view is the one that sees the forcing, and where the
-        // validate runs rest their E_θ cannot (`blind`).
-        let lag_silent = effect.kind() == Kind::Input
-            && c.shaped().is_none()
-            && size_power == Some(false)
-            && g_prof >= -n_prof;
-        let refit_x = x.clone();
-        let x = if silent || lag_silent {
-            x_prof.clone()
-        } else {
-            x
-        };
-        let val = validate(&val_runs, &spec, &x, &cfg.validate)?;
         // Compare with the current model refitted by the same procedure, so that the gain is
         // the effect's and not the local refit's.
         let (current_refit, current_refit_val) = match &baseline[cache] {
@@ -2025,6 +1987,81 @@ pub fn discover(
                 (xc, v)
             }
         };
+        // "Not significantly worse" confirms the screen's value only where the trajectories can
+        // tell the effect from its absence at all, or where the model judged on the held-out
+        // runs carries the screen's value (`silent`): through chaos they often cannot, and a
+        // 0.020 kg·m² "extra inertia" (the refit: 0.00045) that stood in for a mislabelled
+        // encoder passed a profile test with no power. A switch's absence is the current model
+        // without it, refitted by the same procedure: a 0.022 rad encoder backlash through chaos
+        // was named `bearing_load_base_accel`, the screen's μ 0.117 [0.106, 0.129] "fitting the
+        // trajectories" as well as the refit's 0.090, which itself fitted them no better than
+        // the model without the switch.
+        let informative = match (size_power, size_index) {
+            (Some(p), _) => p,
+            (None, Some(_)) => {
+                let (g0, n0) = trajectory_substitution(
+                    &traj_runs,
+                    &current.spec,
+                    &seg_x,
+                    &current_refit,
+                    &traj_ics,
+                    run_zeros,
+                );
+                g0 < -n0
+            }
+            (None, None) => true,
+        };
+        // Trajectories silent on a torque's or an inertia's size (no power, and the screen's
+        // value fits them as well as the refit's): the refit's size is then one point of a flat
+        // profile, and the model judged on the held-out runs carries the screen's value with
+        // the other terms refitted (`x_prof`), the one value both views accept. A 0.0130 N·m
+        // constant dry torque on a drawn design whose two moving identify runs share one bob
+        // (so T_c and μ·load cannot be told apart on them) was refitted at 0.0010 with μ 0.23,
+        // which the validate runs' lighter bobs rejected (held-out E_θ −70 %), while the
+        // screen, seeing every identify run's moving windows, had it at 0.0126.
+        // Not for a shaped effect: its screened size holds only at the shape the screen's
+        // profile chose, and that profile is blind where the shape acts (see `shape_start`); a
+        // breakaway carried at the screen's 5.5e-3 N·m (truth 9.8e-3) lost the held-out fall
+        // its refit had shown.
+        // A switch (no size of its own: it changes a reference parameter, μ for the bearing load
+        // with the base's acceleration) is silent the same way when the trajectories cannot tell
+        // it from its absence (`informative`, judged against the current model's refit) and the
+        // profile through the screen's value fits them as well as the refit. A hidden bearing
+        // load (μ 0.192) on a drawn design whose validate runs all rest was screened at 0.194
+        // (ΔBIC −250) and refitted at 0.145, the refit trading μ for b and a along a flat
+        // profile (the screen's value: E_θ −3.2 % ± 10.6 %); the agreement test then compared
+        // the refit with the screen's narrow interval and refused it, while the validate runs'
+        // E_θ and equation error both fell (82 % ± 47 %, 43.8 % against 34.1 % needed).
+        let switch_silent =
+            effect.params().is_empty() && size_index.is_some() && !informative && g_prof >= -n_prof;
+        let silent = run_zeros
+            && c.shaped().is_none()
+            && (size_power == Some(false) || switch_silent)
+            && g_prof >= -n_prof;
+        // An input effect (the forcing's lag) on a design whose identify runs come to rest: their
+        // trajectories (hand-start transients, free segments) hardly feel the forcing's timing,
+        // and the refit of a lag is then one point of a flat profile, its value and even its
+        // sign set by where Nelder–Mead wandered. A hidden 5.87 ms lag screened at 5.82 ms
+        // [5.71, 5.94] was refused because its refit had drifted to 6.47 ms (+11 %, outside the
+        // 10 % band) while the profile through the screen's value fitted the trajectories as
+        // well (E_θ −0.02 % ± 2.6 %) and the refit set to 0 did no worse either; the validate
+        // runs' E_θ fell 89 % ± 42 % and their equation error 99.7 %. The trajectories' own
+        // interval then holds the screen's value, so the views agree, and the model judged on
+        // the held-out runs carries the screen's value (the other terms refitted). Its
+        // held-out bar stays the input effect's own (below), not `silent`'s both-views one: an
+        // input effect's equation-error view is the one that sees the forcing, and where the
+        // validate runs rest their E_θ cannot (`blind`).
+        let lag_silent = effect.kind() == Kind::Input
+            && c.shaped().is_none()
+            && size_power == Some(false)
+            && g_prof >= -n_prof;
+        let refit_x = x.clone();
+        let x = if silent || lag_silent {
+            x_prof.clone()
+        } else {
+            x
+        };
+        let val = validate(&val_runs, &spec, &x, &cfg.validate)?;
         // The current model once more, refitted from where the candidate's own refit left its
         // other terms (the effect's size at 0: the profile through its absence). A refit that
         // adds a term also moves the others, and can leave a basin the current model's own
@@ -2124,30 +2161,6 @@ pub fn discover(
         // The refitted value of the effect's size.
         let refit_est = size_index.map_or(f64::NAN, |i| refit_x[i]);
         let possible = physically_possible(&c.effect, est);
-        // "Not significantly worse" confirms the screen's value only where the trajectories can
-        // tell the effect from its absence at all, or where the model judged on the held-out
-        // runs carries the screen's value (`silent`): through chaos they often cannot, and a
-        // 0.020 kg·m² "extra inertia" (the refit: 0.00045) that stood in for a mislabelled
-        // encoder passed a profile test with no power. A switch's absence is the current model
-        // without it, refitted by the same procedure: a 0.022 rad encoder backlash through chaos
-        // was named `bearing_load_base_accel`, the screen's μ 0.117 [0.106, 0.129] "fitting the
-        // trajectories" as well as the refit's 0.090, which itself fitted them no better than
-        // the model without the switch.
-        let informative = match (size_power, size_index) {
-            (Some(p), _) => p,
-            (None, Some(_)) => {
-                let (g0, n0) = trajectory_substitution(
-                    &traj_runs,
-                    &current.spec,
-                    &seg_x,
-                    &current_refit,
-                    &traj_ics,
-                    run_zeros,
-                );
-                g0 < -n0
-            }
-            (None, None) => true,
-        };
         let screen_fits_trajectories = g_prof >= -n_prof && (informative || silent);
         // A refit that stops at its search range's bound was set by the bound, not by the data
         // (the range is already widened to hold the screen's value, `ModelSpec::hold`): it
@@ -2459,7 +2472,11 @@ pub fn discover(
             ),
         };
         let mut row = row;
-        if silent || lag_silent {
+        if switch_silent && silent {
+            row.note.push_str(
+                "; the trajectories cannot tell the switch from its absence (the current model refitted does no worse, the screen's value fits them as well): the model judged on the held-out runs carries the screen's value, the other terms refitted",
+            );
+        } else if silent || lag_silent {
             row.note.push_str(
                 "; the trajectories cannot tell its size (the refit's set to 0 does no worse, the screen's fits them as well): the model judged on the held-out runs carries the screen's value, the other terms refitted",
             );
