@@ -104,6 +104,13 @@ fn assert_found(s: &DiscoverSummary, effect: &str, truth: f64, rel: f64, abs: f6
     }
     let accepted = s.discovery.accepted();
     assert_eq!(accepted, vec![effect], "accepted {accepted:?}");
+    // Every catalogue effect beyond the reference model's own terms has its row, estimable or
+    // not (one the screen could not estimate once vanished from the table).
+    for name in pendulum_model::effects::names() {
+        if !["viscous_linear", "viscous_quadratic", "coulomb_bearing"].contains(&name) {
+            assert!(s.discovery.row(name).is_some(), "no row for {name}");
+        }
+    }
     let row = s.discovery.row(effect).unwrap();
     let err = (row.estimate - truth).abs();
     eprintln!(
