@@ -439,26 +439,6 @@ fn kernel(s: f64) -> (f64, f64) {
     (u.powi(4), -8.0 * u.powi(3) + 48.0 * s * s * u * u)
 }
 
-/// The trapezoid rule's sum Σ K_i f(θ_i) Δt is the exact integral of the kernel interpolated
-/// linearly between samples (a hat of half-width Δt about each) times f sampled at the samples.
-/// For a term periodic in θ with k lobes (sin kθ, cos kθ) on a run turning fast, f is not
-/// smooth on that scale: a 58-lobe cogging torque turns its phase by 58 θ̇ Δt per 5 ms sample,
-/// a whole turn near 21.7 rad/s, where its samples alias into a nearly constant torque whose
-/// window sums are as large as a slow run's (a screened 58-lobe torque then raised a validate
-/// run's equation error fifteen-fold on windows turning at 19–23 rad/s, where the torque itself
-/// averages out). With θ linear across a hat
-/// (θ = θ_i + θ̇_i (t − t_i); its curvature moves kθ by under 0.02 rad there), the hat's exact
-/// integral of e^{ikθ} is Δt e^{ikθ_i} sinc²(k θ̇_i Δt / 2): the sample's value times this
-/// factor. `swept` is θ̇_i Δt, rad; 1 for a term that is not periodic (`lobes` 0).
-pub(crate) fn hat_factor(lobes: u32, swept: f64) -> f64 {
-    let x = 0.5 * f64::from(lobes) * swept;
-    if x.abs() < 1e-6 {
-        return 1.0;
-    }
-    let sinc = x.sin() / x;
-    sinc * sinc
-}
-
 /// Uniform resampling of θ at the encoder's median rate; `None` entries mark gaps.
 fn resample(t: &[f64], y: &[f64], t_from: f64, t_to: f64, dt: f64) -> Vec<Option<f64>> {
     let n = ((t_to - t_from) / dt).floor().max(0.0) as usize + 1;
@@ -616,10 +596,8 @@ pub fn weak_rows(run_idx: usize, run: &RunData, al: &Alignment, cfg: &WeakConfig
                     a_y: ay,
                     a_y_dot: ay_dot,
                 };
-                // The angle this sample's hat spans on either side (see `hat_factor`).
-                let swept = thd[i].unwrap_or(0.0) * dt;
                 for (xi, col) in x.iter_mut().zip(columns()) {
-                    *xi += kk * (col.reg.term)(&sample) * hat_factor(col.reg.lobes, swept);
+                    *xi += kk * (col.reg.term)(&sample);
                 }
             }
             let tau_c = a + c as f64 * dt;
@@ -712,96 +690,6 @@ mod tests {
             );
             let bob = rig.m_kg * rig.l_m * rig.l_m;
             assert!(j.abs() < 0.01 * bob, "h = {hw}: J {j}");
-        }
-    }
-}
-
-#[cfg(test)]
-mod lobe_tests {
-    use super::*;
-    use pendulum_process::{RigParams, Role};
-
-    /// A run turning steadily at `w` rad/s, sampled at 200 Hz (the serial format's rate), as a
-    /// free segment of 3 s.
-    fn turning(w: f64) -> (RunData, Alignment) {
-        let rig = RigParams {
-            m_kg: 1.46,
-            l_m: 0.265,
-            crank_r_m: 0.0725,
-            rod_l_m: 0.575,
-            r_b_m: 0.01225,
-            omega_hz: Some(1.5),
-            g_m_s2: 9.81,
-        };
-        let (mut run, mut al) = super::shaped_tests::decay(
-            &rig,
-            pendulum_model::Dimensionless::conservative(),
-            0.1,
-            3.0,
-        );
-        run.role = Role::Identify;
-        run.enc_t_s = (0..=600).map(|i| i as f64 * 0.005).collect();
-        run.theta_rad = run.enc_t_s.iter().map(|t| 0.3 + w * t).collect();
-        al.free_segment_s = (0.0, 3.0);
-        (run, al)
-    }
-
-    /// A many-lobed position torque's columns on a fast-turning run are the window integrals
-    /// of sin kθ and cos kθ (here by a 200-fold finer quadrature of the exact θ), not the
-    /// aliased sum of their samples; on a slow run they are unchanged to the trapezoid's order.
-    #[test]
-    fn a_many_lobed_column_is_integrated_not_aliased_on_a_fast_run() {
-        use pendulum_model::effects::by_name;
-        let pos = by_name("position_torque").unwrap();
-        let cfg = WeakConfig::default();
-        // 21.7 rad/s turns a 58-lobe term by 2π + 0.01 rad per 5 ms sample: its samples alone
-        // would read as a nearly constant torque.
-        for (w, k) in [(21.7, 58u32), (20.0, 58), (20.0, 17), (1.0, 58), (0.3, 64)] {
-            let (run, al) = turning(w);
-            let rows = weak_rows(0, &run, &al, &cfg);
-            assert!(rows.len() >= 5, "{} rows", rows.len());
-            let w0 = run.rig.omega0_rad_s();
-            let dt = 0.005;
-            let half = (cfg.half_width_s / dt).round() as usize;
-            let cols: Vec<usize> = (0..columns().len())
-                .filter(|&i| {
-                    columns()[i].effect.name() == pos.name() && columns()[i].reg.lobes == k
-                })
-                .collect();
-            assert_eq!(cols.len(), 2);
-            for r in &rows {
-                for &ci in &cols {
-                    let col = columns()[ci];
-                    let factor = si_factors(&run.rig)[ci];
-                    // The exact window integral: θ linear, kernel over the window's span.
-                    let n = 200 * 2 * half;
-                    let h = 2.0 * half as f64 * dt / n as f64;
-                    let (t_lo, t_c) = (r.tau_s - half as f64 * dt, r.tau_s);
-                    let mut exact = 0.0;
-                    let mut scale = 0.0;
-                    for j in 0..=n {
-                        let t = t_lo + j as f64 * h;
-                        let (kern, _) = kernel((t - t_c) / (half as f64 * dt));
-                        let wgt = if j == 0 || j == n { 0.5 } else { 1.0 };
-                        let th = 0.3 + w * (t + al.t0_s);
-                        let s = WeakSample {
-                            theta: th,
-                            theta_dot: w / w0,
-                            a_y: 0.0,
-                            a_y_dot: 0.0,
-                        };
-                        exact += kern * wgt * h * w0 * (col.reg.term)(&s) * factor;
-                        scale += kern * wgt * h * w0 * factor;
-                    }
-                    let err = (r.x[ci] - exact).abs();
-                    assert!(
-                        err < 0.01 * scale,
-                        "ω {w} rad/s, k {k}, column {}: {:.4e} against the integral {exact:.4e} (scale {scale:.4e})",
-                        col.reg.name,
-                        r.x[ci]
-                    );
-                }
-            }
         }
     }
 }

@@ -10,7 +10,6 @@ pub struct EncoderOffset;
 static REGRESSORS: [Regressor; 1] = [Regressor {
     name: "offset",
     group: 0,
-    lobes: 0,
     term: |s| (1.0 + s.a_y) * s.theta.cos(),
     per_si: |_| 1.0,
 }];

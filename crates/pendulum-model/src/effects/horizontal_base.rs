@@ -10,7 +10,6 @@ pub struct HorizontalBase;
 static REGRESSORS: [Regressor; 1] = [Regressor {
     name: "horiz",
     group: 0,
-    lobes: 0,
     term: |s| s.a_y * s.theta.cos(),
     per_si: |_| 1.0,
 }];

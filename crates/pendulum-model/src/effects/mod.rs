@@ -202,11 +202,6 @@ pub struct Regressor {
     /// The candidate it belongs to: columns sharing a group enter the regression together
     /// (position_torque's harmonic k: sin kθ and cos kθ); 0 for an effect with one candidate.
     pub group: u32,
-    /// Lobes per turn of a term periodic in θ (position_torque's sin kθ and cos kθ: k); 0 for
-    /// a term that is not. The weak form integrates such a term over each sample's share of
-    /// its window exactly (see `pendulum_discover::weak::hat_factor`), where sampling it at the
-    /// samples alone aliases a many-lobed torque on a fast-turning run into a slow one.
-    pub lobes: u32,
     /// The term at one sample.
     pub term: fn(&WeakSample) -> f64,
     /// Dimensionless coefficient per unit of the SI parameter, for a run's m, l, r_b, g.
