@@ -126,6 +126,32 @@ fn nan() -> f64 {
     f64::NAN
 }
 
+impl DiagnosisRow {
+    /// A row with nothing estimated (every number NaN): an effect the screen could not judge,
+    /// or the `unexplained` row, whose words are its content.
+    fn words_only(effect: &str, unit: &str, note: String) -> Self {
+        DiagnosisRow {
+            effect: effect.into(),
+            accepted: false,
+            estimate: f64::NAN,
+            ci_low: f64::NAN,
+            ci_high: f64::NAN,
+            unit: unit.into(),
+            delta_bic: f64::NAN,
+            heldout_gain: f64::NAN,
+            heldout_noise: f64::NAN,
+            heldout_eq_gain: f64::NAN,
+            screen_estimate: f64::NAN,
+            refit_estimate: f64::NAN,
+            refit_ci_low: f64::NAN,
+            refit_ci_high: f64::NAN,
+            e_validate_before: f64::NAN,
+            e_validate_after: f64::NAN,
+            note,
+        }
+    }
+}
+
 /// Everything discover found.
 #[derive(Debug, Clone)]
 pub struct Discovery {
@@ -2765,28 +2791,14 @@ pub fn discover(
         let unit = pendulum_model::effects::by_name(&c.effect)
             .and_then(|e| e.params().first().map(|p| p.unit))
             .unwrap_or("1");
-        rows.push(DiagnosisRow {
-            effect: c.effect.clone(),
-            accepted: false,
-            estimate: f64::NAN,
-            ci_low: f64::NAN,
-            ci_high: f64::NAN,
-            unit: unit.into(),
-            delta_bic: f64::NAN,
-            heldout_gain: f64::NAN,
-            heldout_noise: f64::NAN,
-            heldout_eq_gain: f64::NAN,
-            screen_estimate: f64::NAN,
-            refit_estimate: f64::NAN,
-            refit_ci_low: f64::NAN,
-            refit_ci_high: f64::NAN,
-            e_validate_before: f64::NAN,
-            e_validate_after: f64::NAN,
-            note: format!(
+        rows.push(DiagnosisRow::words_only(
+            &c.effect,
+            unit,
+            format!(
                 "not estimable on the identify runs' {} equation-error windows: its column cannot be told from the model's there (too few windows where the pendulum moves under the shaker); neither found nor ruled out",
                 view0.id_rows.len()
             ),
-        });
+        ));
     }
 
     // What stays unexplained, and where.
@@ -3008,25 +3020,7 @@ pub fn discover(
         (None, s) => s,
     };
     if let Some(w) = &unexplained {
-        rows.push(DiagnosisRow {
-            effect: "unexplained".into(),
-            accepted: false,
-            estimate: f64::NAN,
-            ci_low: f64::NAN,
-            ci_high: f64::NAN,
-            unit: "-".into(),
-            delta_bic: f64::NAN,
-            heldout_gain: f64::NAN,
-            heldout_noise: f64::NAN,
-            heldout_eq_gain: f64::NAN,
-            screen_estimate: f64::NAN,
-            refit_estimate: f64::NAN,
-            refit_ci_low: f64::NAN,
-            refit_ci_high: f64::NAN,
-            e_validate_before: f64::NAN,
-            e_validate_after: f64::NAN,
-            note: w.clone(),
-        });
+        rows.push(DiagnosisRow::words_only("unexplained", "-", w.clone()));
     }
     if let Some(row) = accel_gain_row(ctx_drift.as_ref().unwrap_or(ctx), cfg) {
         // Before `unexplained`, which stays last.
