@@ -2058,8 +2058,7 @@ pub fn discover(
         // profile (the screen's value: E_θ −3.2 % ± 10.6 %); the agreement test then compared
         // the refit with the screen's narrow interval and refused it, while the validate runs'
         // E_θ and equation error both fell (82 % ± 47 %, 43.8 % against 34.1 % needed).
-        let switch_silent =
-            effect.params().is_empty() && size_index.is_some() && !informative && g_prof >= -n_prof;
+        let switch_silent = effect.params().is_empty() && size_index.is_some() && !informative;
         let silent = run_zeros
             && c.shaped().is_none()
             && (size_power == Some(false) || switch_silent)
