@@ -29,6 +29,10 @@ pub struct Term {
     pub shape: &'static str,
     /// Unit of f, so that the coefficient's unit is N·m / this.
     pub unit: &'static str,
+    /// Lobes per turn of a term that is one harmonic of θ times a slow factor (sin kθ: k), 0
+    /// otherwise: the weak form integrates such a term over each sample's hat, as it does the
+    /// catalogue's periodic columns ([`crate::weak::hat_factor`]).
+    pub lobes: u32,
 }
 
 /// The library, in the order of [`library_values`].
@@ -61,53 +65,61 @@ pub const LIBRARY: [Term; 23] = [
         "a gravity torque out of step with the measured angle (the angle's scale is off)",
         "rad",
     ),
-    t(
+    tl(
         "sin θ",
         Variable::AngleInTurn,
         "periodic in θ with 1 lobe",
         "1",
+        1,
     ),
-    t(
+    tl(
         "cos θ",
         Variable::AngleInTurn,
         "periodic in θ with 1 lobe",
         "1",
+        1,
     ),
-    t(
+    tl(
         "sin 2θ",
         Variable::AngleInTurn,
         "periodic in θ with 2 lobes",
         "1",
+        2,
     ),
-    t(
+    tl(
         "cos 2θ",
         Variable::AngleInTurn,
         "periodic in θ with 2 lobes",
         "1",
+        2,
     ),
-    t(
+    tl(
         "sin 3θ",
         Variable::AngleInTurn,
         "periodic in θ with 3 lobes",
         "1",
+        3,
     ),
-    t(
+    tl(
         "cos 3θ",
         Variable::AngleInTurn,
         "periodic in θ with 3 lobes",
         "1",
+        3,
     ),
-    t(
+    tl(
         "sin 4θ",
         Variable::AngleInTurn,
         "periodic in θ with 4 lobes",
         "1",
+        4,
     ),
-    t(
+    tl(
         "cos 4θ",
         Variable::AngleInTurn,
         "periodic in θ with 4 lobes",
         "1",
+        4,
     ),
     t("sin φ", Variable::Phase, "at the crank frequency", "1"),
     t("cos φ", Variable::Phase, "at the crank frequency", "1"),
@@ -133,11 +145,12 @@ pub const LIBRARY: [Term; 23] = [
     // The gravity torque's size following the speed: a bob that moves out as it speeds up (loose
     // or springy on its rod; its centrifugal stretch grows with θ̇², and with it the gravity
     // torque and the inertia, whose change shows through θ̈ ≈ −(1 + A_y) sin θ the same way).
-    t(
+    tl(
         "θ̇² (1 + A_y) sin θ",
         Variable::Rate,
         "the gravity torque growing with (dθ/dt)² (a bob that moves out as it speeds up: loose or springy on its rod)",
         "(rad/s)²",
+        1,
     ),
 ];
 
@@ -183,11 +196,23 @@ const fn t(
     shape: &'static str,
     unit: &'static str,
 ) -> Term {
+    tl(name, variable, shape, unit, 0)
+}
+
+/// A term with `lobes` lobes per turn (see [`Term::lobes`]).
+const fn tl(
+    name: &'static str,
+    variable: Variable,
+    shape: &'static str,
+    unit: &'static str,
+    lobes: u32,
+) -> Term {
     Term {
         name,
         variable,
         shape,
         unit,
+        lobes,
     }
 }
 

@@ -439,6 +439,60 @@ fn kernel(s: f64) -> (f64, f64) {
     (u.powi(4), -8.0 * u.powi(3) + 48.0 * s * s * u * u)
 }
 
+/// The trapezoid rule's sum Σ K_i f_i Δt is the exact integral of the kernel interpolated
+/// linearly between samples (a hat of half-width Δt about each sample) times f taken at the
+/// samples. That is right for the kernel, which changes over the window, not for f, which on a
+/// fast-turning run does not stay put over a hat: the gravity torque sin θ summed at its samples
+/// is off by (θ̇Δt)²/12 of itself (8e-4 of m g l at 20 rad/s and 200 Hz, as large as a small
+/// cogging torque), and the forcing's product A_y sin θ turns at θ̇ ± the crank's rate, which
+/// makes it worse. On a run whose rotation locked to the crank that bias followed the forcing
+/// phase and θ (mod 2π): a one-way F of 30 on the forcing phase of one run under a drifting
+/// motor, and a 2.5e-4 N·m one-lobed position torque named beside the hidden drift. So each
+/// sample's f is its hat's average: θ through the sample and its two neighbours (a quadratic),
+/// the forcing at its own time, at [`HAT_NODES`] (three Gauss–Legendre points on either side,
+/// weighted by the hat).
+///
+/// A many-lobed position torque (more than [`HAT_QUADRATURE_MAX_LOBES`] lobes) turns too fast
+/// for a few points: a 58-lobe cogging torque turns its phase by 58 θ̇ Δt per 5 ms sample, a
+/// whole turn near 21.7 rad/s, where its samples alias into a nearly constant torque whose
+/// window sums are as large as a slow run's (a screened 58-lobe torque then raised a validate
+/// run's equation error fifteen-fold on windows turning at 19–23 rad/s, where the torque itself
+/// averages out). With θ linear across a hat (θ = θ_i + θ̇_i (t − t_i); its curvature moves kθ
+/// by under 0.02 rad there), the hat's exact integral of e^{ikθ} is Δt e^{ikθ_i}
+/// sinc²(k θ̇_i Δt / 2): the sample's value times this factor. `swept` is θ̇_i Δt, rad; 1 for a
+/// term that is not periodic (`lobes` 0).
+pub(crate) fn hat_factor(lobes: u32, swept: f64) -> f64 {
+    let x = 0.5 * f64::from(lobes) * swept;
+    if x.abs() < 1e-6 {
+        return 1.0;
+    }
+    let sinc = x.sin() / x;
+    sinc * sinc
+}
+
+/// Columns with more lobes per turn than this are integrated over a hat by [`hat_factor`]; those
+/// with fewer (but at least one) by the quadrature [`HAT_NODES`] (against the exact hat integral of cos(a + b s):
+/// 2.5e-12 off at b = 0.1 rad per sample, 1.0e-8 at 0.4 rad, four lobes at 20 rad/s and 200 Hz).
+pub(crate) const HAT_QUADRATURE_MAX_LOBES: u32 = 4;
+
+/// (s, w): the hat ∫(1 − |s|) f(s) ds over s ∈ [−1, 1] (samples) as Σ w f(s): three
+/// Gauss–Legendre points on [0, 1] mirrored, each weighted by 1 − |s| (exact for f of degree 4
+/// on either side); Σ w = 1.
+const HAT_NODES: [(f64, f64); 6] = {
+    // Nodes 0.5 (1 + x), x = 0, ±√(3/5); weights 8/18, 5/18 (on [0, 1]).
+    const R: f64 = 0.774_596_669_241_483_4;
+    const U: [f64; 3] = [0.5 * (1.0 - R), 0.5, 0.5 * (1.0 + R)];
+    const W: [f64; 3] = [5.0 / 18.0, 8.0 / 18.0, 5.0 / 18.0];
+    [
+        (U[0], W[0] * (1.0 - U[0])),
+        (U[1], W[1] * (1.0 - U[1])),
+        (U[2], W[2] * (1.0 - U[2])),
+        (-U[0], W[0] * (1.0 - U[0])),
+        (-U[1], W[1] * (1.0 - U[1])),
+        (-U[2], W[2] * (1.0 - U[2])),
+    ]
+};
+
 /// Uniform resampling of θ at the encoder's median rate; `None` entries mark gaps.
 fn resample(t: &[f64], y: &[f64], t_from: f64, t_to: f64, dt: f64) -> Vec<Option<f64>> {
     let n = ((t_to - t_from) / dt).floor().max(0.0) as usize + 1;
@@ -577,27 +631,77 @@ pub fn weak_rows(run_idx: usize, run: &RunData, al: &Alignment, cfg: &WeakConfig
                 } else {
                     (0.0, 0.0, f64::NAN)
                 };
-
-                let sn = th_i.sin();
                 let kk = k * wgt * dtt;
-                let lv = crate::sparse::library_values(th_i, w * w0, phase_i, tau, ay);
-                for (li, v) in lib.iter_mut().zip(lv) {
-                    *li += kk * v * torque_factor;
-                }
                 speeds.push((kk * torque_factor, w * w0));
                 // ∫K''θ dt with d²/dt² = (1/h²) d²/ds², about the window's centre value: ∫K'' = 0
                 // exactly, but not its discrete sum, which would multiply a rotating run's
                 // unwrapped angle (tens of rad) into the result.
                 let theta_dd = k2 / (h_dimless * h_dimless) * (th_i - th_c) * wgt * dtt;
-                target -= theta_dd + kk * (1.0 + ay) * sn;
+                target -= theta_dd;
+                // The gravity torque and every term periodic in θ over this sample's hat (see
+                // `HAT_NODES`): θ through its two neighbours (a quadratic), the forcing where it
+                // is. (The rest, smooth on a sample's scale, at the sample: as the shaped
+                // columns are, so that a breakaway's column at a large v_s stays the constant
+                // dry torque's.)
+                let (Some(th_prev), Some(th_next)) = (grid[i - 1], grid[i + 1]) else {
+                    unreachable!("θ̇ at a sample needs its neighbours");
+                };
+                let slope = 0.5 * (th_next - th_prev); // rad per step
+                let curve = th_next - 2.0 * th_i + th_prev; // rad per step²
+                let mut lv = [0.0; crate::sparse::LIBRARY.len()];
+                for &(s_hat, w_hat) in &HAT_NODES {
+                    let th_s = th_i + s_hat * (slope + 0.5 * s_hat * curve);
+                    let w_s = w + s_hat * curve / dt / w0;
+                    let tau_s = tau + s_hat * dt;
+                    let (ay, ay_dot, phase_s) = if forced {
+                        forcing(tau_s)
+                    } else {
+                        (0.0, 0.0, f64::NAN)
+                    };
+                    let kw = kk * w_hat;
+                    target -= kw * (1.0 + ay) * th_s.sin();
+                    let l = crate::sparse::library_values(th_s, w_s * w0, phase_s, tau_s, ay);
+                    for ((acc, v), term) in lv.iter_mut().zip(l).zip(&crate::sparse::LIBRARY) {
+                        if term.lobes > 0 {
+                            *acc += w_hat * v;
+                        }
+                    }
+                    let sample = WeakSample {
+                        theta: th_s,
+                        theta_dot: w_s,
+                        a_y: ay,
+                        a_y_dot: ay_dot,
+                    };
+                    for (xi, col) in x.iter_mut().zip(columns()) {
+                        if (1..=HAT_QUADRATURE_MAX_LOBES).contains(&col.reg.lobes) {
+                            *xi += kw * (col.reg.term)(&sample);
+                        }
+                    }
+                }
+                let at_sample = crate::sparse::library_values(th_i, w * w0, phase_i, tau, ay);
+                for (((li, v), v0), term) in lib
+                    .iter_mut()
+                    .zip(lv)
+                    .zip(at_sample)
+                    .zip(&crate::sparse::LIBRARY)
+                {
+                    *li += kk * torque_factor * if term.lobes > 0 { v } else { v0 };
+                }
+                // The smooth terms at the sample; a many-lobed torque (no forcing in it) over
+                // the hat exactly, θ linear.
                 let sample = WeakSample {
                     theta: th_i,
                     theta_dot: w,
                     a_y: ay,
                     a_y_dot: ay_dot,
                 };
+                let swept = thd[i].unwrap_or(0.0) * dt;
                 for (xi, col) in x.iter_mut().zip(columns()) {
-                    *xi += kk * (col.reg.term)(&sample);
+                    if col.reg.lobes == 0 {
+                        *xi += kk * (col.reg.term)(&sample);
+                    } else if col.reg.lobes > HAT_QUADRATURE_MAX_LOBES {
+                        *xi += kk * (col.reg.term)(&sample) * hat_factor(col.reg.lobes, swept);
+                    }
                 }
             }
             let tau_c = a + c as f64 * dt;
@@ -690,6 +794,147 @@ mod tests {
             );
             let bob = rig.m_kg * rig.l_m * rig.l_m;
             assert!(j.abs() < 0.01 * bob, "h = {hw}: J {j}");
+        }
+    }
+}
+
+#[cfg(test)]
+mod lobe_tests {
+    use super::*;
+    use pendulum_process::{RigParams, Role};
+
+    /// A run turning steadily at `w` rad/s, sampled at 200 Hz (the serial format's rate), as a
+    /// free segment of 3 s.
+    fn turning(w: f64) -> (RunData, Alignment) {
+        let rig = RigParams {
+            m_kg: 1.46,
+            l_m: 0.265,
+            crank_r_m: 0.0725,
+            rod_l_m: 0.575,
+            r_b_m: 0.01225,
+            omega_hz: Some(1.5),
+            g_m_s2: 9.81,
+        };
+        let (mut run, mut al) = super::shaped_tests::decay(
+            &rig,
+            pendulum_model::Dimensionless::conservative(),
+            0.1,
+            3.0,
+        );
+        run.role = Role::Identify;
+        run.enc_t_s = (0..=600).map(|i| i as f64 * 0.005).collect();
+        run.theta_rad = run.enc_t_s.iter().map(|t| 0.3 + w * t).collect();
+        al.free_segment_s = (0.0, 3.0);
+        (run, al)
+    }
+
+    /// The gravity torque in the target is integrated over each sample's hat (the kernel
+    /// linear between samples, θ as it is): on a run turning at 20 rad/s, sampled every 5 ms,
+    /// the sum of its samples alone is off by (θ̇Δt)²/12 of it, a bias that follows θ.
+    #[test]
+    fn the_gravity_torque_of_a_fast_turning_run_is_integrated_over_each_samples_hat() {
+        let cfg = WeakConfig::default();
+        for w in [20.0, 8.0, 0.5] {
+            let (run, al) = turning(w);
+            let rows = weak_rows(0, &run, &al, &cfg);
+            assert!(rows.len() >= 5, "{} rows", rows.len());
+            let dt = 0.005;
+            let dtt = dt * run.rig.omega0_rad_s();
+            let half = (cfg.half_width_s / dt).round() as i64;
+            let (mut worst, mut worst_samples, mut scale) = (0.0f64, 0.0f64, 0.0f64);
+            for r in &rows {
+                let (mut exact, mut samples) = (0.0, 0.0);
+                for j in -half..=half {
+                    let (kern, _) = kernel(j as f64 / half as f64);
+                    let wgt = if j.abs() == half { 0.5 } else { 1.0 };
+                    let kk = kern * wgt * dtt;
+                    let th_i = 0.3 + w * (al.t0_s + r.tau_s + j as f64 * dt);
+                    // The hat's average of sin θ by a 2000-point midpoint rule.
+                    let n = 2000;
+                    let avg: f64 = (0..n)
+                        .map(|m| {
+                            let s = -1.0 + (m as f64 + 0.5) * 2.0 / n as f64;
+                            (1.0 - s.abs()) * (th_i + w * s * dt).sin() * 2.0 / n as f64
+                        })
+                        .sum();
+                    exact -= kk * avg;
+                    samples -= kk * th_i.sin();
+                    scale = scale.max(kk.abs());
+                }
+                worst = worst.max((r.target - exact).abs());
+                worst_samples = worst_samples.max((samples - exact).abs());
+            }
+            let scale = scale * 2.0 * half as f64;
+            assert!(
+                worst < 2e-6 * scale,
+                "ω {w} rad/s: target off the hat integral by {worst:.3e} (scale {scale:.3e})"
+            );
+            if w >= 20.0 {
+                // What the samples alone would give: the check above can tell.
+                assert!(
+                    worst_samples > 1e-4 * scale,
+                    "ω {w} rad/s: the samples alone are only {worst_samples:.3e} off"
+                );
+            }
+        }
+    }
+
+    /// A many-lobed position torque's columns on a fast-turning run are the window integrals
+    /// of sin kθ and cos kθ (here by a 200-fold finer quadrature of the exact θ), not the
+    /// aliased sum of their samples; on a slow run they are unchanged to the trapezoid's order.
+    #[test]
+    fn a_many_lobed_column_is_integrated_not_aliased_on_a_fast_run() {
+        use pendulum_model::effects::by_name;
+        let pos = by_name("position_torque").unwrap();
+        let cfg = WeakConfig::default();
+        // 21.7 rad/s turns a 58-lobe term by 2π + 0.01 rad per 5 ms sample: its samples alone
+        // would read as a nearly constant torque.
+        for (w, k) in [(21.7, 58u32), (20.0, 58), (20.0, 17), (1.0, 58), (0.3, 64)] {
+            let (run, al) = turning(w);
+            let rows = weak_rows(0, &run, &al, &cfg);
+            assert!(rows.len() >= 5, "{} rows", rows.len());
+            let w0 = run.rig.omega0_rad_s();
+            let dt = 0.005;
+            let half = (cfg.half_width_s / dt).round() as usize;
+            let cols: Vec<usize> = (0..columns().len())
+                .filter(|&i| {
+                    columns()[i].effect.name() == pos.name() && columns()[i].reg.lobes == k
+                })
+                .collect();
+            assert_eq!(cols.len(), 2);
+            for r in &rows {
+                for &ci in &cols {
+                    let col = columns()[ci];
+                    let factor = si_factors(&run.rig)[ci];
+                    // The exact window integral: θ linear, kernel over the window's span.
+                    let n = 200 * 2 * half;
+                    let h = 2.0 * half as f64 * dt / n as f64;
+                    let (t_lo, t_c) = (r.tau_s - half as f64 * dt, r.tau_s);
+                    let mut exact = 0.0;
+                    let mut scale = 0.0;
+                    for j in 0..=n {
+                        let t = t_lo + j as f64 * h;
+                        let (kern, _) = kernel((t - t_c) / (half as f64 * dt));
+                        let wgt = if j == 0 || j == n { 0.5 } else { 1.0 };
+                        let th = 0.3 + w * (t + al.t0_s);
+                        let s = WeakSample {
+                            theta: th,
+                            theta_dot: w / w0,
+                            a_y: 0.0,
+                            a_y_dot: 0.0,
+                        };
+                        exact += kern * wgt * h * w0 * (col.reg.term)(&s) * factor;
+                        scale += kern * wgt * h * w0 * factor;
+                    }
+                    let err = (r.x[ci] - exact).abs();
+                    assert!(
+                        err < 0.01 * scale,
+                        "ω {w} rad/s, k {k}, column {}: {:.4e} against the integral {exact:.4e} (scale {scale:.4e})",
+                        col.reg.name,
+                        r.x[ci]
+                    );
+                }
+            }
         }
     }
 }

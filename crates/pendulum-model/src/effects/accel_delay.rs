@@ -10,6 +10,7 @@ pub struct AccelDelay;
 static REGRESSORS: [Regressor; 1] = [Regressor {
     name: "delay",
     group: 0,
+    lobes: 1,
     term: |s| s.a_y_dot * s.theta.sin(),
     per_si: |p| p.omega0_rad_s(),
 }];

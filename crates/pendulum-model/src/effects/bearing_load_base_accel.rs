@@ -11,6 +11,7 @@ pub struct BearingLoadBaseAccel;
 static REGRESSORS: [Regressor; 1] = [Regressor {
     name: "coul_base",
     group: 0,
+    lobes: 0,
     term: |s| (s.theta_dot * s.theta_dot + (1.0 + s.a_y) * s.theta.cos()).abs() * s.sgn(),
     per_si: |p| p.r_b_m / p.l_m,
 }];

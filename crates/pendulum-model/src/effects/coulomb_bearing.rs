@@ -11,6 +11,7 @@ pub struct CoulombBearing;
 static REGRESSORS: [Regressor; 1] = [Regressor {
     name: "coul_ref",
     group: 0,
+    lobes: 0,
     term: |s| (s.theta_dot * s.theta_dot + s.theta.cos()).abs() * s.sgn(),
     per_si: |p| p.r_b_m / p.l_m,
 }];

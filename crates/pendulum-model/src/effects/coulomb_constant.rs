@@ -10,6 +10,7 @@ pub struct CoulombConstant;
 static REGRESSORS: [Regressor; 1] = [Regressor {
     name: "const",
     group: 0,
+    lobes: 0,
     term: |s| s.sgn(),
     per_si: |p| 1.0 / (p.m_kg * p.g_m_s2 * p.l_m),
 }];

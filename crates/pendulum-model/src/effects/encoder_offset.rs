@@ -10,6 +10,7 @@ pub struct EncoderOffset;
 static REGRESSORS: [Regressor; 1] = [Regressor {
     name: "offset",
     group: 0,
+    lobes: 1,
     term: |s| (1.0 + s.a_y) * s.theta.cos(),
     per_si: |_| 1.0,
 }];

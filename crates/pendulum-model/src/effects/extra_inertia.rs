@@ -11,6 +11,7 @@ pub struct ExtraInertia;
 static REGRESSORS: [Regressor; 1] = [Regressor {
     name: "inertia",
     group: 0,
+    lobes: 1,
     term: |s| -(1.0 + s.a_y) * s.theta.sin(),
     per_si: |p| 1.0 / (p.m_kg * p.l_m * p.l_m),
 }];

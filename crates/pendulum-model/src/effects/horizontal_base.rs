@@ -10,6 +10,7 @@ pub struct HorizontalBase;
 static REGRESSORS: [Regressor; 1] = [Regressor {
     name: "horiz",
     group: 0,
+    lobes: 1,
     term: |s| s.a_y * s.theta.cos(),
     per_si: |_| 1.0,
 }];

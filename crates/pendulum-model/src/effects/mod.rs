@@ -202,6 +202,13 @@ pub struct Regressor {
     /// The candidate it belongs to: columns sharing a group enter the regression together
     /// (position_torque's harmonic k: sin kθ and cos kθ); 0 for an effect with one candidate.
     pub group: u32,
+    /// Lobes per turn of a term that is one harmonic of θ times a slowly varying factor
+    /// (position_torque's sin kθ and cos kθ: k; (1 + A_y) sin θ, A_y cos θ: 1); 0 for a term
+    /// that is not. The weak form integrates such a term over each sample's share of its
+    /// window exactly (see `pendulum_discover::weak::hat_factor`), where sampling it at the
+    /// samples alone aliases a many-lobed torque on a fast-turning run into a slow one, and
+    /// biases even a one-lobed one by (θ̇Δt)²/12.
+    pub lobes: u32,
     /// The term at one sample.
     pub term: fn(&WeakSample) -> f64,
     /// Dimensionless coefficient per unit of the SI parameter, for a run's m, l, r_b, g.

@@ -21,12 +21,14 @@ macro_rules! lobes {
             Regressor {
                 name: concat!("pos", stringify!($k), "_sin"),
                 group: $k,
+                lobes: $k,
                 term: |s| ($k as f64 * s.theta).sin(),
                 per_si: TORQUE,
             },
             Regressor {
                 name: concat!("pos", stringify!($k), "_cos"),
                 group: $k,
+                lobes: $k,
                 term: |s| ($k as f64 * s.theta).cos(),
                 per_si: TORQUE,
             },

@@ -10,6 +10,7 @@ pub struct ViscousLinear;
 static REGRESSORS: [Regressor; 1] = [Regressor {
     name: "lin",
     group: 0,
+    lobes: 0,
     term: |s| s.theta_dot,
     per_si: |p| 1.0 / (p.m_kg * p.omega0_rad_s()),
 }];

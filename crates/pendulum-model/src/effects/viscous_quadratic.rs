@@ -10,6 +10,7 @@ pub struct ViscousQuadratic;
 static REGRESSORS: [Regressor; 1] = [Regressor {
     name: "quad",
     group: 0,
+    lobes: 0,
     term: |s| s.theta_dot * s.theta_dot.abs(),
     per_si: |p| p.l_m / p.m_kg,
 }];
