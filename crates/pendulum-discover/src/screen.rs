@@ -106,9 +106,7 @@ pub fn candidates(base: Base) -> Vec<Candidate> {
             });
             continue;
         }
-        let mut groups: Vec<u32> = e.regressors().iter().map(|r| r.group).collect();
-        groups.dedup();
-        for k in groups {
+        for k in variants(*e) {
             out.push(Candidate {
                 effect: e.name().into(),
                 add: group_columns(e.name(), k),
@@ -445,16 +443,19 @@ pub fn profile_shape_band(
 /// generator (ΔBIC −11.3, its held-out E_θ 7 % worse), a 2.5e-4 N·m k = 1 one beside a hidden
 /// speed drift (−16.9); the hidden cogging torques the surveys named screened at −26 and below.
 pub(crate) fn look_elsewhere(effect: &str) -> f64 {
-    let Some(e) = pendulum_model::effects::by_name(effect) else {
-        return 0.0;
-    };
-    let mut groups: Vec<u32> = e.regressors().iter().map(|r| r.group).collect();
-    groups.dedup();
-    if groups.len() > 1 {
-        2.0 * (groups.len() as f64).ln()
+    let m = pendulum_model::effects::by_name(effect).map_or(1, |e| variants(e).len());
+    if m > 1 {
+        2.0 * (m as f64).ln()
     } else {
         0.0
     }
+}
+
+/// An effect's candidates: its regressor groups (position_torque's k), in order.
+fn variants(e: &dyn pendulum_model::Effect) -> Vec<u32> {
+    let mut groups: Vec<u32> = e.regressors().iter().map(|r| r.group).collect();
+    groups.dedup();
+    groups
 }
 
 /// ΔBIC of every candidate against `current` columns. A shaped candidate is profiled over its
