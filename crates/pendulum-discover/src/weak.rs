@@ -751,11 +751,9 @@ mod tests {
     use pendulum_model::Dimensionless;
     use pendulum_process::RigParams;
 
-    /// On an exact free decay with viscous + bearing friction, the weak-form regression returns
-    /// β and M (an independent check of the integration by parts and the scalings).
-    #[test]
-    fn weak_form_recovers_free_decay_damping() {
-        let rig = RigParams {
+    /// The study's rig (rig.md), turning the crank at 1.5 Hz.
+    pub(super) fn study_rig() -> RigParams {
+        RigParams {
             m_kg: 1.46,
             l_m: 0.265,
             crank_r_m: 0.0725,
@@ -763,7 +761,14 @@ mod tests {
             r_b_m: 0.01225,
             omega_hz: Some(1.5),
             g_m_s2: 9.81,
-        };
+        }
+    }
+
+    /// On an exact free decay with viscous + bearing friction, the weak-form regression returns
+    /// β and M (an independent check of the integration by parts and the scalings).
+    #[test]
+    fn weak_form_recovers_free_decay_damping() {
+        let rig = study_rig();
         let w0 = rig.omega0_rad_s();
         let mut d = Dimensionless::conservative();
         d.beta = 0.05;
@@ -801,20 +806,12 @@ mod tests {
 #[cfg(test)]
 mod lobe_tests {
     use super::*;
-    use pendulum_process::{RigParams, Role};
+    use pendulum_process::Role;
 
     /// A run turning steadily at `w` rad/s, sampled at 200 Hz (the serial format's rate), as a
     /// free segment of 3 s.
     fn turning(w: f64) -> (RunData, Alignment) {
-        let rig = RigParams {
-            m_kg: 1.46,
-            l_m: 0.265,
-            crank_r_m: 0.0725,
-            rod_l_m: 0.575,
-            r_b_m: 0.01225,
-            omega_hz: Some(1.5),
-            g_m_s2: 9.81,
-        };
+        let rig = super::tests::study_rig();
         let (mut run, mut al) = super::shaped_tests::decay(
             &rig,
             pendulum_model::Dimensionless::conservative(),
