@@ -1334,6 +1334,37 @@ fn a_run_zeroed_off_by_counts_does_not_hide_a_cogging_torque() {
     );
 }
 
+/// A breakaway of 7.8e-3 N·m fading at 0.37 rad/s (the seventh survey draws' `stribeck` k=3,
+/// `SURVEY_SEED=6`) whose trajectory refit ran its speed scale to the top of its search range,
+/// 2.0 rad/s (a constant dry torque on every slow swing), and its size down to 1.34e-3 N·m: it
+/// was named there, −83 %, on 0f9516a. A refit set by a bound confirms nothing, its shape's bound
+/// as much as its size's: named within 10 % or not at all, and then saying why.
+#[test]
+fn a_breakaway_whose_refit_runs_its_speed_scale_to_the_range_end_is_not_named_there() {
+    let (truth, spec, base, a, b, mu) = draw_scaled("stribeck", &mut rng(602_203), 1.0);
+    let s = discover(606_203, base, a, b, mu, &spec);
+    let accepted = s.discovery.accepted();
+    let row = s.discovery.row("stribeck").expect("a stribeck row");
+    eprintln!("note stribeck: {}", row.note);
+    if accepted == ["stribeck"] {
+        assert!(
+            (row.estimate - truth).abs() <= 0.1 * truth,
+            "named at {:.4e} N·m for {truth:.4e}",
+            row.estimate
+        );
+        return;
+    }
+    assert!(
+        accepted.is_empty(),
+        "hidden T_s {truth:.4e} N·m; named {accepted:?}"
+    );
+    assert!(
+        row.note.contains("its size's or its shape's"),
+        "{}",
+        row.note
+    );
+}
+
 /// A constant dry torque at 0.4 × the survey's sizes (4.1e-3 N·m, the 0.4 × survey's
 /// `coulomb_constant` k=1) that the screen ranks second, ΔBIC −11.5, to a breakaway whose speed
 /// scale its profile put at 1.2 rad/s (a dry torque that fades only at the fastest swings), ΔBIC

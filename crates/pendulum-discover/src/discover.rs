@@ -2192,7 +2192,16 @@ pub fn discover(
         // confirms nothing. An encoder counting 7 % under its header was named a 0.032 kg·m²
         // extra inertia whose refit sat at its widened bound, 0.04. (A size at 0 with the range
         // starting there is the effect's absence, which the agreement below judges.)
-        let refit_pinned = size_index.is_some_and(|i| {
+        // So is a shaped effect's refit whose shape stopped at an end of its range: a breakaway
+        // refitted at v_s = 2.0 rad/s, the range's top (effects.md: 0.05–0.5), is a constant dry
+        // torque on every slow swing, and one was named at 1.34e-3 N·m for a hidden 7.8e-3 with
+        // v_s 0.37 (the trajectories holding [0, 4.0e-3]); another, at v_s 0.0116 (the bottom),
+        // was named beside a linear damping nobody had hidden a breakaway under.
+        let shape_index = effect
+            .rate_shape()
+            .and_then(|s| FitParam::find(s.key))
+            .and_then(|p| spec.params.iter().position(|q| *q == p));
+        let refit_pinned = [size_index, shape_index].into_iter().flatten().any(|i| {
             let p = spec.params[i];
             match spec.at_end(p, refit_x[i]) {
                 Some(pendulum_process::fit::Side::Lower) => spec.range(p).0 != 0.0,
@@ -2475,7 +2484,7 @@ pub fn discover(
                 } else if !practically_significant(&c.effect, est, jitter_s, bob_inertia) {
                     "; within the rig's own tolerance (encoder zeroing, the stamps' timing jitter, or the inertia the point-mass bob leaves out): not named"
                 } else if refit_pinned {
-                    "; the trajectory refit stops at its search range's bound (the bound, not the data, set it): not accepted"
+                    "; the trajectory refit stops at its search range's bound, its size's or its shape's (the bound, not the data, set it): not accepted"
                 } else if !agree {
                     "; the trajectory refit disagrees with the screen: not accepted"
                 } else if second_look && !informative {
