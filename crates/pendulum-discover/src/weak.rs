@@ -605,7 +605,15 @@ pub fn weak_rows(run_idx: usize, run: &RunData, al: &Alignment, cfg: &WeakConfig
                 (thd[i].unwrap_or(0.0) / w0).abs() < cfg.stuck_theta_dot
                     && ((1.0 + ay) * grid[i].unwrap_or(0.0).sin()).abs() < cfg.stick_torque_max
             });
-            if may_stick {
+            // A window still from end to end is at rest wherever it sits: its friction is
+            // static and unknown, whatever angle the encoder reports. (An encoder zeroed 0.079
+            // rad off the hanging position put seven resting runs past `stick_torque_max`, and
+            // their still windows, each asking for a torque of 0.079 m g l, were explained by a
+            // breakaway, a position torque and a negative dry torque before the offset.)
+            let still = range
+                .clone()
+                .all(|i| (thd[i].unwrap_or(0.0) / w0).abs() < cfg.stuck_theta_dot);
+            if may_stick || still {
                 c += 2 * half;
                 continue;
             }
@@ -823,6 +831,26 @@ mod lobe_tests {
         run.theta_rad = run.enc_t_s.iter().map(|t| 0.3 + w * t).collect();
         al.free_segment_s = (0.0, 3.0);
         (run, al)
+    }
+
+    /// A run still from end to end gives no rows, wherever its encoder says it rests: its
+    /// friction is static and unknown. Resting at 0.08 rad (an encoder zeroed off the hanging
+    /// position, past `stick_torque_max`), its windows asked for a torque of 0.08 m g l.
+    #[test]
+    fn a_still_run_gives_no_rows_wherever_its_encoder_says_it_rests() {
+        let cfg = WeakConfig::default();
+        let (moving, al) = turning(1.0);
+        assert!(!weak_rows(0, &moving, &al, &cfg).is_empty());
+        for theta in [0.0, 0.08, -0.3, 2.0] {
+            let mut run = moving.clone();
+            run.theta_rad.iter_mut().for_each(|v| *v = theta);
+            let rows = weak_rows(0, &run, &al, &cfg);
+            assert!(
+                rows.is_empty(),
+                "at rest at {theta} rad: {} rows",
+                rows.len()
+            );
+        }
     }
 
     /// The gravity torque in the target is integrated over each sample's hat (the kernel
