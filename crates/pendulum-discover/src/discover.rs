@@ -1511,8 +1511,7 @@ fn shape_start(
     shape: &pendulum_model::effects::RateShape,
     evals: usize,
 ) -> Vec<f64> {
-    let Some(i) = FitParam::find(shape.key).and_then(|p| spec.params.iter().position(|q| *q == p))
-    else {
+    let Some(i) = spec.index_of(shape.key) else {
         return x0.to_vec();
     };
     std::iter::once(x0[i])
@@ -1870,10 +1869,7 @@ pub fn discover(
         let (mut spec, mut news) = extend(&current.spec, c, &fit);
         // Where the refit holds the effect's size: its own first parameter, or the reference
         // parameter a switch changes (μ for bearing_load_base_accel).
-        let size_index = effect
-            .size_key()
-            .and_then(FitParam::find)
-            .and_then(|p| spec.params.iter().position(|q| *q == p));
+        let size_index = effect.size_key().and_then(|k| spec.index_of(k));
         if nonlinear {
             if let Some(n) = news.first_mut() {
                 n.1 = est;
@@ -2197,10 +2193,7 @@ pub fn discover(
         // torque on every slow swing, and one was named at 1.34e-3 N·m for a hidden 7.8e-3 with
         // v_s 0.37 (the trajectories holding [0, 4.0e-3]); another, at v_s 0.0116 (the bottom),
         // was named beside a linear damping nobody had hidden a breakaway under.
-        let shape_index = effect
-            .rate_shape()
-            .and_then(|s| FitParam::find(s.key))
-            .and_then(|p| spec.params.iter().position(|q| *q == p));
+        let shape_index = effect.rate_shape().and_then(|s| spec.index_of(s.key));
         let refit_pinned = [size_index, shape_index].into_iter().flatten().any(|i| {
             let p = spec.params[i];
             match spec.at_end(p, refit_x[i]) {

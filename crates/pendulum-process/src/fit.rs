@@ -268,6 +268,12 @@ impl ModelSpec {
         }
     }
 
+    /// Where this model's parameter vector holds the parameter keyed `key` (`"stribeck.v_s"`),
+    /// if it fits it.
+    pub fn index_of(&self, key: &str) -> Option<usize> {
+        FitParam::find(key).and_then(|p| self.params.iter().position(|q| *q == p))
+    }
+
     /// The search range of `p` in this model: widened, or the catalogue's ([`FitParam::bounds`]).
     pub fn range(&self, p: FitParam) -> (f64, f64) {
         self.ranges
