@@ -2243,20 +2243,20 @@ pub fn discover(
         let adds_loss = cols
             .iter()
             .any(|col| !current_cols.contains(col) && crate::weak::is_loss(*col));
-        let runs_disagree = adds_loss
-            && ols(&view.id_rows, &cols).is_some_and(|f| {
-                let res = f.residuals(&view.weak);
-                let pooled: Vec<f64> = cols
-                    .iter()
-                    .map(|&col| f.coef_of(col).map_or(0.0, |v| v.0))
-                    .collect();
-                crate::sparse::run_spread(&view.weak, &res, &cols, &pooled, &every_run).is_some_and(
-                    |sp| {
-                        sp.heldout_gain
-                            > SECOND_LOOK_GAIN_FACTOR * sp.heldout_noise.max(cfg.eq_gain_min)
-                    },
-                )
-            });
+        // (The candidate's own screen fit on the identify rows, `fit`, gives the pooled sizes.)
+        let runs_disagree = adds_loss && {
+            let res = fit.residuals(&view.weak);
+            let pooled: Vec<f64> = cols
+                .iter()
+                .map(|&col| fit.coef_of(col).map_or(0.0, |v| v.0))
+                .collect();
+            crate::sparse::run_spread(&view.weak, &res, &cols, &pooled, &every_run).is_some_and(
+                |sp| {
+                    sp.heldout_gain
+                        > SECOND_LOOK_GAIN_FACTOR * sp.heldout_noise.max(cfg.eq_gain_min)
+                },
+            )
+        };
         let plausible = partial.is_none()
             && !runs_disagree
             && practically_significant(&c.effect, est, jitter_s, bob_inertia)
