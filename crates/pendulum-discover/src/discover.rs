@@ -3195,22 +3195,8 @@ mod tests {
                     } else {
                         1.0
                     };
-                    let noise = uniform();
-                    WeakRow {
-                        run: i % 4,
-                        tau_s: 0.0,
-                        theta: 0.0,
-                        theta_dot_rad_s: 0.0,
-                        phase: 0.0,
-                        a_y_meas: 0.0,
-                        a_x_meas: 0.0,
-                        target: 0.3 * x[drag] + 0.25 * x[dry] + noise,
-                        x,
-                        weight: 1.0,
-                        bob_inertia_kg_m2: 0.1,
-                        lib: Vec::new(),
-                        speeds: Default::default(),
-                    }
+                    let target = 0.3 * x[drag] + 0.25 * x[dry] + uniform();
+                    crate::weak::test_row(i % 4, 0.1, x, target)
                 })
                 .collect()
         };

@@ -619,21 +619,7 @@ mod tests {
     use super::*;
 
     fn row(run: usize, bob: f64, x: Vec<f64>, target: f64) -> WeakRow {
-        WeakRow {
-            run,
-            tau_s: 0.0,
-            theta: 0.0,
-            theta_dot_rad_s: 0.0,
-            phase: 0.0,
-            a_y_meas: 0.0,
-            a_x_meas: 0.0,
-            target,
-            x,
-            weight: 1.0,
-            bob_inertia_kg_m2: bob,
-            lib: Vec::new(),
-            speeds: Default::default(),
-        }
+        crate::weak::test_row(run, bob, x, target)
     }
 
     /// Two bobs (m l² = 0.1025 and 0.0504 kg·m²) with extra inertia J = 0.008 kg·m²: the

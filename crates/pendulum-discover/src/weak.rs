@@ -1099,6 +1099,27 @@ mod shaped_tests {
     }
 }
 
+/// A row of unit weight holding only a run, a bob, regressors and a target: what the unit tests
+/// of the regressions need.
+#[cfg(test)]
+pub(crate) fn test_row(run: usize, bob_inertia_kg_m2: f64, x: Vec<f64>, target: f64) -> WeakRow {
+    WeakRow {
+        run,
+        tau_s: 0.0,
+        theta: 0.0,
+        theta_dot_rad_s: 0.0,
+        phase: 0.0,
+        a_y_meas: 0.0,
+        a_x_meas: 0.0,
+        target,
+        x,
+        weight: 1.0,
+        bob_inertia_kg_m2,
+        lib: Vec::new(),
+        speeds: Default::default(),
+    }
+}
+
 #[cfg(test)]
 mod contrast_tests {
     use super::*;
@@ -1106,21 +1127,7 @@ mod contrast_tests {
     fn row(run: usize, x_offset: f64, target: f64) -> WeakRow {
         let mut x = vec![0.0; columns().len()];
         x[observation_column().unwrap()] = x_offset;
-        WeakRow {
-            run,
-            tau_s: 0.0,
-            theta: 0.0,
-            theta_dot_rad_s: 0.0,
-            phase: 0.0,
-            a_y_meas: 0.0,
-            a_x_meas: 0.0,
-            target,
-            x,
-            weight: 1.0,
-            bob_inertia_kg_m2: 0.1,
-            lib: Vec::new(),
-            speeds: Default::default(),
-        }
+        test_row(run, 0.1, x, target)
     }
 
     /// With per-run offsets θ_r, the offset column estimates their mean weighted by each run's
