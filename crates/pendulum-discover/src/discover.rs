@@ -1568,7 +1568,8 @@ const HELDOUT_Z: f64 = 1.96;
 /// residuals under `fit`): the fall their equation error would show were the candidate true at
 /// that size. A torque that acts in a few windows, or one smaller than the rows' noise, reaches
 /// little of it; whether that share clears the bar a fall must clear says whether the rows could
-/// see the candidate at all.
+/// see the candidate at all. (The columns are taken as they are, without the extra inertia's
+/// divisor or the runs' zeroing refits: a share, not a prediction to the percent.)
 fn eq_reach(rows: &[WeakRow], fit: &crate::screen::Ols, current: &[usize], after: &[f64]) -> f64 {
     let added: Vec<(usize, f64)> = fit
         .columns
