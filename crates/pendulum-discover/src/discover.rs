@@ -2580,7 +2580,8 @@ pub fn discover(
                 "; the validate runs' E_θ does not respond to the effect itself (its size set to 0 in the refitted model scores within the noise): their E_θ cannot see it, and its rise is the other terms' trade",
             );
         }
-        if !nonlinear && !eq_powered && !second_look {
+        // (Only where it did not confirm it anyway: a view may clear its bar beyond its reach.)
+        if !nonlinear && !eq_powered && !second_look && eq_gain <= eq_needed {
             row.note.push_str(&format!(
                 "; the validate runs' equation error cannot see it (were it true at the screen's size, it would fall {:.1} %, short of its bar): it neither confirms nor contradicts, and E_θ judges it",
                 100.0 * reach
