@@ -650,17 +650,21 @@ pub fn weak_rows(run_idx: usize, run: &RunData, al: &Alignment, cfg: &WeakConfig
         // `deriv_max_half_width_s`) where θ moves by fewer than `DERIV_MIN_COUNTS` encoder
         // counts across the window: near a turning point.
         let hd_max = ((cfg.deriv_max_half_width_s / dt).round() as usize).max(hd);
+        let window = |i: usize, h: usize| -> Option<Vec<f64>> {
+            if i < h {
+                return None;
+            }
+            grid.get(i - h..=i + h)?.iter().copied().collect()
+        };
         let mut thd = vec![None; n];
-        for i in hd..n.saturating_sub(hd) {
+        for (i, slot) in thd
+            .iter_mut()
+            .enumerate()
+            .take(n.saturating_sub(hd))
+            .skip(hd)
+        {
             let mut h = hd;
-            loop {
-                let Some(win) = grid
-                    .get(i.wrapping_sub(h)..=i + h)
-                    .filter(|_| i >= h)
-                    .and_then(|w| w.iter().copied().collect::<Option<Vec<f64>>>())
-                else {
-                    break;
-                };
+            while let Some(win) = window(i, h) {
                 let (lo, hi) = win
                     .iter()
                     .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
@@ -676,7 +680,7 @@ pub fn weak_rows(run_idx: usize, run: &RunData, al: &Alignment, cfg: &WeakConfig
                 let Ok(fit) = pendulum_numerics::ols(&rows_x, &win) else {
                     break;
                 };
-                thd[i] = Some(fit.coef[1] / (h as f64 * dt));
+                *slot = Some(fit.coef[1] / (h as f64 * dt));
                 if hi - lo >= DERIV_MIN_COUNTS * ENCODER_COUNT_RAD || h >= hd_max {
                     break;
                 }
