@@ -1982,17 +1982,34 @@ pub fn discover(
         // would not do: the refit's other terms co-adapt to its value (μ to a dry torque). The
         // profile through the screen's value: the other parameters refitted with the effect's
         // held at the screen's estimate.
+        // A screened size beyond the top of the refit's own search range is not a model the
+        // trajectories are asked about: the profile is not run, and the screen's value does
+        // not fit them. (A rectifying generator screened at 1.07e6 N·m·s/rad, its column
+        // nearly empty above a 11.4 rad/s band, made the profile's every trajectory so stiff
+        // that one departures-survey campaign ran for over 40 minutes instead of one.)
         let x_prof = match size_index {
+            Some(i) if est > spec.range(spec.params[i]).1 => None,
             Some(i) => {
                 let mut start = x0.clone();
                 start[i] = est;
-                refit_profile(&traj_runs, &spec, &start, &traj_ics, cfg.refit_evals, i)
+                Some(refit_profile(
+                    &traj_runs,
+                    &spec,
+                    &start,
+                    &traj_ics,
+                    cfg.refit_evals,
+                    i,
+                ))
             }
-            None => x0.clone(),
+            None => Some(x0.clone()),
         };
         let seg_x = substitution_segments(&traj_runs, &spec, &x, &traj_ics, run_zeros);
-        let (g_prof, n_prof) =
-            trajectory_substitution(&traj_runs, &spec, &seg_x, &x_prof, &traj_ics, run_zeros);
+        let (g_prof, n_prof) = match &x_prof {
+            Some(xp) => {
+                trajectory_substitution(&traj_runs, &spec, &seg_x, xp, &traj_ics, run_zeros)
+            }
+            None => (f64::NEG_INFINITY, 0.0),
+        };
         // Can the trajectories tell the effect's size from its absence at all (the refit with
         // the size set to 0 significantly worse)? For a switch (no size of its own) this is
         // asked below, against the current model's refit.
@@ -2107,10 +2124,9 @@ pub fn discover(
             && size_power == Some(false)
             && g_prof >= -n_prof;
         let refit_x = x.clone();
-        let x = if silent || lag_silent {
-            x_prof.clone()
-        } else {
-            x
+        let x = match &x_prof {
+            Some(xp) if silent || lag_silent => xp.clone(),
+            _ => x,
         };
         let val = validate(&val_runs, &spec, &x, &cfg.validate)?;
         // The current model once more, refitted from where the candidate's own refit left its
