@@ -1985,8 +1985,8 @@ pub fn discover(
         // A screened size beyond the top of the refit's own search range is not a model the
         // trajectories are asked about: the profile is not run, and the screen's value does
         // not fit them. (A rectifying generator screened at 1.07e6 N·m·s/rad, its column
-        // nearly empty above a 11.4 rad/s band, made the profile's every trajectory so stiff
-        // that one departures-survey campaign ran for over 40 minutes instead of one.)
+        // nearly empty above an 11.4 rad/s band, made the profile's every trajectory so stiff
+        // that one departures-survey campaign ran for about 50 minutes instead of one.)
         let x_prof = match size_index {
             Some(i) if est > spec.range(spec.params[i]).1 => None,
             Some(i) => {
