@@ -433,7 +433,8 @@ impl Default for WeakConfig {
     }
 }
 
-/// One encoder count (rig.md: 4096 per revolution), rad.
+/// One encoder count (rig.md: 4096 per revolution), rad: only the scale of the widening below,
+/// so a capture whose header gives other counts per revolution is not read differently.
 const ENCODER_COUNT_RAD: f64 = std::f64::consts::TAU / 4096.0;
 
 /// Counts θ must move across the local cubic's window for its slope to be read from the motion
@@ -517,7 +518,7 @@ const HAT_NODES: [(f64, f64); 6] = {
 
 /// (s, w, θ̇ rad/s): the hat of a sample over which θ̇ (linear between this sample's rate and
 /// its neighbours') changes sign, split where it does, three Gauss–Legendre points per piece
-/// weighted by the hat (Σ w = 1, exact for a term polynomial in s on either side of each
+/// weighted by the hat (Σ w = 1, exact for a term of degree ≤ 4 in s on either side of each
 /// change); `None` where θ̇ keeps its sign over the hat (or a neighbour's rate is unknown).
 ///
 /// Why: a term with sgn θ̇ in it (a dry torque, a breakaway) summed at the samples gives each
