@@ -978,6 +978,46 @@ fn a_lag_the_resting_identify_runs_cannot_size_is_named_at_the_screens_value() {
     );
 }
 
+/// The every-effect survey's eighth draws (`SURVEY_SEED=7`), `accel_delay` k = 2: a 7.9 ms lag
+/// on a design whose five identify runs all come to rest and one of whose three validate runs
+/// is in chaos. The screen put the lag at ΔBIC −11.9, tied with a tilted base; its stepwise
+/// choice took the tilt, which the held-out views refused (refit negative, E_θ +1.8 %), and the
+/// lag was never judged. Judged, its trajectory refit wandered to 44.9 ms (the profile flat
+/// between that and the screen's 10.7 ms [5.7, 15.7]) and the chaotic run's E_θ rose 333 %.
+/// The candidate the screen passed over is judged in its turn, and a lag whose refit wanders
+/// outside the screen's interval along a flat profile is judged at the screen's value: named,
+/// alone, with the truth inside the screen's interval (its value is 35 % high: the resting runs
+/// leave the screen few forced windows).
+#[test]
+fn a_lag_tied_with_a_refused_tilt_is_judged_and_named_at_the_screens_value() {
+    let truth = 0.00791693249123327;
+    let s = discover(
+        705_902,
+        Base::Reference,
+        0.0,
+        0.5,
+        0.15,
+        &format!("accel_delay_s = {truth}"),
+    );
+    assert_eq!(
+        s.discovery.accepted(),
+        ["accel_delay"],
+        "{}",
+        s.report.display()
+    );
+    let row = s.discovery.row("accel_delay").unwrap();
+    assert!(
+        row.ci_low <= truth && truth <= row.ci_high,
+        "truth {truth} outside the screen's [{}, {}]",
+        row.ci_low,
+        row.ci_high
+    );
+    assert_eq!(row.estimate, row.screen_estimate, "{}", row.note);
+    assert!(row.note.contains("refit wandered"), "{}", row.note);
+    let tilt = s.discovery.row("horizontal_base").unwrap();
+    assert!(!tilt.accepted);
+}
+
 /// The every-effect survey's sixth draws (`SURVEY_SEED=5`), `bearing_load_base_accel` k = 2: the
 /// bearing load carrying the base's acceleration (μ 0.192) on a design whose three validate runs
 /// all rest. The screen had μ at 0.194 (ΔBIC −250) and the validate runs confirmed it (E_θ −82 %

@@ -550,6 +550,29 @@ pub struct Stepwise {
     pub nuisance: Vec<usize>,
 }
 
+impl Stepwise {
+    /// The order in which discover judges the candidates: the chosen ones, then those the first
+    /// round passed (ΔBIC below `threshold` against the base alone) that were not chosen, best
+    /// first, one per effect. A candidate is passed over when one chosen before it explains the
+    /// same rows; if the held-out views then refuse the chosen one, the one it displaced deserves
+    /// its own judgement. A hidden 7.9 ms accelerometer lag on a design whose identify runs all
+    /// came to rest screened at ΔBIC −11.9, tied with a tilted base (−11.9); the stepwise screen
+    /// took the tilt, whose refit went negative and whose held-out E_θ rose 1.8 %, and the lag
+    /// was never judged.
+    pub fn queue(&self, threshold: f64) -> Vec<Screened> {
+        let mut q = self.chosen.clone();
+        for s in &self.first_round {
+            if s.delta_bic < threshold
+                && !is_nuisance(s)
+                && !q.iter().any(|c| c.candidate.effect == s.candidate.effect)
+            {
+                q.push(s.clone());
+            }
+        }
+        q
+    }
+}
+
 /// Forward stepwise selection: the sequence of candidates that each lower BIC by more than
 /// `threshold` given the ones before (at most `max_effects`), on top of the base's columns and
 /// `extra` nuisance columns. A best candidate that is only a normal rig tolerance
