@@ -1018,6 +1018,31 @@ fn a_lag_tied_with_a_refused_tilt_is_judged_and_named_at_the_screens_value() {
     assert!(!tilt.accepted);
 }
 
+/// The same draws, `accel_delay` k = 0: a 9.3 ms lag, named within 0.1 %. The re-screen after it
+/// chose a cogging torque (ΔBIC −31.1), refused on the held-out views, and passed over a
+/// breakaway (−17.9) that, judged in its turn, the screen put below zero (−4.4e-3 N·m
+/// [−6.1e-3, −2.8e-3]): reported as an `unexplained` departure beside the right answer. A
+/// candidate the screen passed over may be named, but its refusal is no new departure.
+#[test]
+fn a_breakaway_the_screen_passed_over_is_no_departure_beside_a_named_lag() {
+    let truth = 0.00928245381417283;
+    let s = discover(
+        705_900,
+        Base::Reference,
+        0.0,
+        0.5,
+        0.15,
+        &format!("accel_delay_s = {truth}"),
+    );
+    assert_found(&s, "accel_delay", truth, 0.01, 0.0);
+    assert_eq!(s.discovery.accepted(), ["accel_delay"]);
+    assert!(
+        s.discovery.unexplained.is_none(),
+        "{:?}",
+        s.discovery.unexplained
+    );
+}
+
 /// The every-effect survey's sixth draws (`SURVEY_SEED=5`), `bearing_load_base_accel` k = 2: the
 /// bearing load carrying the base's acceleration (μ 0.192) on a design whose three validate runs
 /// all rest. The screen had μ at 0.194 (ΔBIC −250) and the validate runs confirmed it (E_θ −82 %
