@@ -1814,17 +1814,11 @@ pub fn discover(
     // to the next: a hidden dry torque screened first (ΔBIC −175) beside a 40-odd-lobe cogging
     // torque (ΔBIC −97) did not lower the validate runs' errors enough while the cogging was
     // unmodelled, and ended the search with neither named.
+    // Then those the stepwise screen passed over ([`Stepwise::passed_over`]), named in `passed`.
+    let over = screened.passed_over(cfg.screen_threshold);
+    let mut passed: Vec<String> = over.iter().map(|s| s.candidate.effect.clone()).collect();
     let mut queue: std::collections::VecDeque<_> =
-        screened.queue(cfg.screen_threshold).into_iter().collect();
-    // The queue's candidates that the stepwise screen passed over ([`Stepwise::queue`]).
-    let passed_over = |sw: &crate::screen::Stepwise| -> Vec<String> {
-        sw.queue(cfg.screen_threshold)
-            .into_iter()
-            .skip(sw.chosen.len())
-            .map(|s| s.candidate.effect)
-            .collect()
-    };
-    let mut passed: Vec<String> = passed_over(&screened);
+        screened.chosen.iter().cloned().chain(over).collect();
     let mut next = queue.pop_front();
     let mut round = 0;
     // The second look at the dry frictions (see [`SecondLook`]), at every candidate when the base
@@ -2815,10 +2809,12 @@ pub fn discover(
                 // k = 4 cogging torque, accepted at −3.8 %, was followed by a k = 63 candidate of
                 // the same effect (ΔBIC −10.4) that was refused; its row replaced the accepted
                 // one, so the report named nothing while its model held the k = 4 torque.
-                passed = passed_over(&sw);
+                let over = sw.passed_over(cfg.screen_threshold);
+                passed = over.iter().map(|s| s.candidate.effect.clone()).collect();
                 queue = sw
-                    .queue(cfg.screen_threshold)
+                    .chosen
                     .iter()
+                    .chain(&over)
                     .filter(|sc| {
                         !confirmed
                             .iter()

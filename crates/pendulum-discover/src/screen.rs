@@ -551,25 +551,26 @@ pub struct Stepwise {
 }
 
 impl Stepwise {
-    /// The order in which discover judges the candidates: the chosen ones, then those the first
-    /// round passed (ΔBIC below `threshold` against the base alone) that were not chosen, best
-    /// first, one per effect. A candidate is passed over when one chosen before it explains the
-    /// same rows; if the held-out views then refuse the chosen one, the one it displaced deserves
-    /// its own judgement. A hidden 7.9 ms accelerometer lag on a design whose identify runs all
-    /// came to rest screened at ΔBIC −11.9, tied with a tilted base (−11.9); the stepwise screen
-    /// took the tilt, whose refit went negative and whose held-out E_θ rose 1.8 %, and the lag
-    /// was never judged.
-    pub fn queue(&self, threshold: f64) -> Vec<Screened> {
-        let mut q = self.chosen.clone();
+    /// The candidates the first round passed (ΔBIC below `threshold` against the base alone)
+    /// that were not chosen, best first, one per effect. A candidate is passed over when one
+    /// chosen before it explains the same rows; if the held-out views then refuse the chosen
+    /// one, the one it displaced deserves its own judgement, after the chosen ones. A hidden
+    /// 7.9 ms accelerometer lag on a design whose identify runs all came to rest screened at
+    /// ΔBIC −11.9, tied with a tilted base (−11.9); the stepwise screen took the tilt, whose
+    /// refit went negative and whose held-out E_θ rose 1.8 %, and the lag was never judged.
+    pub fn passed_over(&self, threshold: f64) -> Vec<Screened> {
+        let mut over: Vec<Screened> = Vec::new();
         for s in &self.first_round {
+            let seen = |c: &Screened| c.candidate.effect == s.candidate.effect;
             if s.delta_bic < threshold
                 && !is_nuisance(s)
-                && !q.iter().any(|c| c.candidate.effect == s.candidate.effect)
+                && !self.chosen.iter().any(seen)
+                && !over.iter().any(seen)
             {
-                q.push(s.clone());
+                over.push(s.clone());
             }
         }
-        q
+        over
     }
 }
 

@@ -437,12 +437,6 @@ impl Default for WeakConfig {
 /// so a capture whose header gives other counts per revolution is not read differently.
 const ENCODER_COUNT_RAD: f64 = std::f64::consts::TAU / 4096.0;
 
-/// Counts θ must move across the local cubic's window for its slope to be read from the motion
-/// rather than from where the counts happen to change. Near a turning point θ stays within one
-/// count for √(2 q / θ̈) (13 ms at 18 rad/s²): the ±20 ms cubic then saw two or three counts,
-/// and the time θ̇ changed sign was wherever the last count changed, off by as much as a
-/// breakaway's whole width (v_s/θ̈, 10 ms at 0.18 rad/s): the breakaway's column from
-/// quantised angles was off by 0.66 of itself (`a_breakaways_column_from_encoder_counts_…`).
 /// Weights giving the slope b1 (per unit x) of the least-squares cubic through 2h + 1 equally
 /// spaced samples at x_j = (j − h)/h, j = 0..=2h (see where it is used).
 fn cubic_slope_filter(h: usize) -> Vec<f64> {
@@ -455,6 +449,12 @@ fn cubic_slope_filter(h: usize) -> Vec<f64> {
     xs.iter().map(|x| (s6 * x - s4 * x.powi(3)) / det).collect()
 }
 
+/// Counts θ must move across the local cubic's window for its slope to be read from the motion
+/// rather than from where the counts happen to change. Near a turning point θ stays within one
+/// count for √(2 q / θ̈) (13 ms at 18 rad/s²): the ±20 ms cubic then saw two or three counts,
+/// and the time θ̇ changed sign was wherever the last count changed, off by as much as a
+/// breakaway's whole width (v_s/θ̈, 10 ms at 0.18 rad/s): the breakaway's column from
+/// quantised angles was off by 0.66 of itself (`a_breakaways_column_from_encoder_counts_…`).
 /// Widened until θ spans this many counts (at most `deriv_max_half_width_s`), the cubic
 /// locates the turn from the counts on both sides; its slope at the turn stays nearly
 /// unbiased, the motion there being nearly even in time. Nearly: dry friction steps θ̈ as θ̇

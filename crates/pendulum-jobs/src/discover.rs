@@ -80,9 +80,8 @@ fn load(path: Option<&Path>) -> Result<DiscoverPipeline, JobError> {
         .map_err(|e| JobError::Invalid(format!("{src}: pipeline: {}", e.message())))
 }
 
-/// The diagnosis as a short table.
-/// A fraction as a percentage, `-` when not measured (NaN).
-/// A gain (a fraction: 1 − after/before) as a percentage for the table's 8-wide columns. A
+/// A gain (a fraction: 1 − after/before) as a percentage, `-` when not measured (NaN), for the
+/// diagnosis table's 8-wide columns. A
 /// candidate far outside anything physical can make a model billions of times worse (a
 /// generator screened at c_g 1e6 N·m·s/rad printed an equation-error "gain" of −3.7e12 %); the
 /// table says only that it is below −999 % (`diagnosis.parquet` keeps the value).
@@ -96,6 +95,7 @@ fn pct(v: f64) -> String {
     }
 }
 
+/// The diagnosis as a short table.
 pub fn diagnosis_table(d: &Discovery) -> String {
     let mut t = String::new();
     let _ = writeln!(
