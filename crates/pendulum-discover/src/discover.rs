@@ -1229,13 +1229,17 @@ fn followed_ics(runs: &[PreparedRun], spec: &ModelSpec, x: &[f64], held: &[f64])
 /// quantisation step (the smallest non-zero change between samples).
 fn is_moving(r: &PreparedRun) -> bool {
     let step = quantisation_step(&r.theta);
-    let (lo, hi) = r
-        .theta
+    step.is_finite() && angle_span(&r.theta) > STILL_SPAN_STEPS * step
+}
+
+/// The range an angle covers, max − min, rad (−∞ for none).
+fn angle_span(theta: &[f64]) -> f64 {
+    let (lo, hi) = theta
         .iter()
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
             (a.min(v), b.max(v))
         });
-    step.is_finite() && hi - lo > STILL_SPAN_STEPS * step
+    hi - lo
 }
 
 /// The identify runs whose angle leaves rest ([`is_moving`]), with their initial states (`ics`:
@@ -1680,13 +1684,9 @@ fn heldout_gain_in_motion(before: &[RunFit], after: &[RunFit], runs: &[PreparedR
     paired_gain(&b, &a)
 }
 
-/// Per multiple-shooting segment of `run` (cut at its restarts, as the objective cuts them):
-/// whether its measured angle stays within [`STILL_TAIL_STEPS`] encoder steps throughout.
+/// Per multiple-shooting segment of `run` ([`PreparedRun::segment_ranges`]): whether its measured
+/// angle stays within [`STILL_TAIL_STEPS`] encoder steps throughout.
 fn still_segments(run: &PreparedRun) -> Vec<bool> {
-    let n = run.theta.len();
-    if n == 0 {
-        return Vec::new();
-    }
     // (An angle that never changes has no step: every segment is still.)
     let step = quantisation_step(&run.theta);
     let tol = if step.is_finite() {
@@ -1694,23 +1694,9 @@ fn still_segments(run: &PreparedRun) -> Vec<bool> {
     } else {
         0.0
     };
-    let mut cuts = vec![0];
-    cuts.extend(
-        run.restarts
-            .iter()
-            .map(|(i, _)| *i)
-            .filter(|&i| i > 0 && i < n),
-    );
-    cuts.push(n);
-    cuts.windows(2)
-        .map(|w| {
-            let (lo, hi) = run.theta[w[0]..w[1]]
-                .iter()
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
-                    (a.min(v), b.max(v))
-                });
-            hi - lo <= tol + 1e-12
-        })
+    run.segment_ranges()
+        .into_iter()
+        .map(|r| angle_span(&run.theta[r]) <= tol + 1e-12)
         .collect()
 }
 
@@ -2436,7 +2422,11 @@ pub fn discover(
         // (v_s 0.185) and took 53 % ± 21 % off the validate runs' E_θ, but its screen at its
         // own profile's shape said 2.4e-3 (ΔBIC −1.8) and its validate equation error fell
         // 10 % (37 % needed); at v_s 0.185 the identify rows said 1.12e-2 ± 0.35e-2 and the
-        // validate rows fell 28 %.
+        // validate rows fell 28 %. That view must also tell it from the effect it generalises (a
+        // constant dry torque, [`pendulum_model::Effect::generalises`]): its interval beside that
+        // one's column still excludes 0. A breakaway refitted at v_s 1.23 rad/s (over most
+        // swings a constant torque) for a bearing whose μ differed from run to run was named
+        // without it.
         // (shape, screen estimate, its standard error, the validate rows' equation-error fall,
         // and the estimate's lower 95 % bound beside the effect it generalises)
         let at_trajectories_shape = match (c.shaped(), shape_index) {

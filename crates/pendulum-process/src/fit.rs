@@ -530,6 +530,25 @@ pub struct PreparedRun {
 }
 
 impl PreparedRun {
+    /// The sample ranges in `t` of its multiple-shooting segments, in time order: the first from
+    /// t = 0, each later one from a restart inside the window (none for an empty window). The
+    /// objective's E_θ per segment (`Evaluation::per_run_segment_e`) follows these.
+    pub fn segment_ranges(&self) -> Vec<std::ops::Range<usize>> {
+        let n = self.t.len();
+        if n == 0 {
+            return Vec::new();
+        }
+        let mut starts = vec![0];
+        starts.extend(
+            self.restarts
+                .iter()
+                .map(|(i, _)| *i)
+                .filter(|&i| i > 0 && i < n),
+        );
+        let ends = starts.iter().skip(1).copied().chain([n]);
+        starts.iter().zip(ends).map(|(&a, b)| a..b).collect()
+    }
+
     /// This free decay (the free segment before a shaker starts, prepared as a decay) as a run
     /// of the shaker model with the crank still: crank radius 0, the crank's speed `omega_hz`
     /// kept only for the time unit's sake, and a shaker run's time unit sqrt(g/l). An SI model
@@ -591,32 +610,25 @@ struct Segment {
 fn segments(runs: &[PreparedRun]) -> Vec<Segment> {
     let mut out = Vec::new();
     for (j, run) in runs.iter().enumerate() {
-        let n = run.t.len();
-        if n == 0 {
-            continue;
+        let mut restarts = run
+            .restarts
+            .iter()
+            .filter(|(i, _)| *i > 0 && *i < run.t.len());
+        for (k, r) in run.segment_ranges().into_iter().enumerate() {
+            let y0 = if k == 0 {
+                None
+            } else {
+                restarts.next().map(|(_, y)| *y)
+            };
+            debug_assert!(r.start < r.end);
+            out.push(Segment {
+                run: j,
+                t0: if k == 0 { 0.0 } else { run.t[r.start] },
+                i0: r.start,
+                i1: r.end,
+                y0,
+            });
         }
-        let first = out.len();
-        out.push(Segment {
-            run: j,
-            i0: 0,
-            i1: n,
-            t0: 0.0,
-            y0: None,
-        });
-        for &(i, y) in &run.restarts {
-            if i > 0 && i < n {
-                let last = out.len() - 1;
-                out[last].i1 = i;
-                out.push(Segment {
-                    run: j,
-                    i0: i,
-                    i1: n,
-                    t0: run.t[i],
-                    y0: Some(y),
-                });
-            }
-        }
-        debug_assert!(out[first..].iter().all(|g| g.i0 < g.i1));
     }
     out
 }
@@ -1658,6 +1670,38 @@ mod tests {
     /// small share of how far the angle moves), a prediction that stands still at each
     /// segment's start scores exactly 1 (counted by hand over the 50-sample segments), and a run
     /// at rest has no ratio.
+    /// A run's segment ranges cut its window at the restarts inside it (one at its first or
+    /// past its last sample is no cut), cover it without gap or overlap, and are the segments
+    /// the objective reports an E_θ for, one each.
+    #[test]
+    fn segment_ranges_partition_the_window_as_the_objective_cuts_it() {
+        let mut r = run(1.75, STUDY, [1.0, -1.5]);
+        let n = r.t.len();
+        r.restarts.insert(0, (0, [0.0, 0.0]));
+        r.restarts.push((n, [0.0, 0.0]));
+        let ranges = r.segment_ranges();
+        let inner: Vec<usize> = r
+            .restarts
+            .iter()
+            .map(|(i, _)| *i)
+            .filter(|&i| i > 0 && i < n)
+            .collect();
+        assert_eq!(ranges.len(), inner.len() + 1);
+        assert_eq!((ranges[0].start, ranges[ranges.len() - 1].end), (0, n));
+        for (w, &i) in ranges.windows(2).zip(&inner) {
+            assert!(w[0].start < w[0].end && w[0].end == w[1].start && w[1].start == i);
+        }
+        let spec = ModelSpec::reference();
+        let objective = plain_objective(std::slice::from_ref(&r), &spec);
+        let mut x = STUDY.to_vec();
+        x.extend_from_slice(&r.ic_est);
+        let eval = objective.evaluate(&x);
+        assert_eq!(eval.per_run_segment_e[0].len(), ranges.len());
+        let mut empty = r.clone();
+        empty.t.clear();
+        assert!(empty.segment_ranges().is_empty());
+    }
+
     #[test]
     fn misfit_ratio_tells_a_following_model_from_standing_still() {
         let r = run(1.75, STUDY, [1.0, -1.5]);
