@@ -1476,6 +1476,20 @@ fn a_breakaway_both_identify_views_size_alike_at_the_trajectories_shape_is_named
     );
 }
 
+/// A breakaway of 8.55e-3 N·m fading at 0.198 rad/s (the every-effect survey's `stribeck` k=4,
+/// `SURVEY_SEED=8`) was refused with its refit at 3.4e-3 N·m: the shape grid, profiled on the
+/// runs as measured, preferred v_s 1.2 rad/s (objective 7.886 against 7.957 at 0.20), a few
+/// counts of each run's zeroing error outweighing the breakaway's trace; with the zeros held the
+/// refit from there stopped at 2.6e-3 N·m, v_s 0.85 (objective 3.054), while the profile through
+/// the truth's size scored 2.872 and a refit from it stayed at 8.40e-3. The shape is chosen again
+/// once the zeros are held: named within 10 %.
+#[test]
+fn a_breakaway_shape_is_chosen_again_once_each_runs_zeroing_error_is_held() {
+    let (truth, spec, base, a, b, mu) = draw_scaled("stribeck", &mut rng(802_204), 1.0);
+    let s = discover(806_204, base, a, b, mu, &spec);
+    assert_found(&s, "stribeck", truth, 0.10, 0.0);
+}
+
 /// A viscous damping of 0.585 N·s/m hidden under a dry base (the every-effect survey's
 /// `viscous_linear` k=4, `SURVEY_SEED=8`): screened at 0.586 (equation error −100 %) and
 /// refitted at 0.584, it was refused on a validate E_θ rise of 286 % ± 148 %. Every validate run
