@@ -3447,15 +3447,7 @@ mod tests {
         let run = |theta: Vec<f64>| PreparedRun {
             id: "r".into(),
             role: Role::Identify,
-            rig: pendulum_process::RigParams {
-                m_kg: 1.46,
-                l_m: 0.265,
-                crank_r_m: 0.0725,
-                rod_l_m: 0.575,
-                r_b_m: 0.01225,
-                omega_hz: Some(1.5),
-                g_m_s2: 9.81,
-            },
+            rig: crate::weak::tests::study_rig(),
             omega_hz: 1.5,
             t: (0..theta.len()).map(|i| 0.05 * i as f64).collect(),
             restarts: (1..5).map(|s| (20 * s, [theta[20 * s], 0.0])).collect(),

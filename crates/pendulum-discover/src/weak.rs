@@ -908,13 +908,13 @@ pub fn weak_rows(run_idx: usize, run: &RunData, al: &Alignment, cfg: &WeakConfig
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use pendulum_model::Dimensionless;
     use pendulum_process::RigParams;
 
     /// The study's rig (rig.md), turning the crank at 1.5 Hz.
-    pub(super) fn study_rig() -> RigParams {
+    pub(crate) fn study_rig() -> RigParams {
         RigParams {
             m_kg: 1.46,
             l_m: 0.265,
