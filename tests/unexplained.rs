@@ -622,19 +622,6 @@ fn a_growing_dry_torque_is_not_credited_with_the_damping_its_refit_repairs() {
     named_nothing("dry_torque_growth", 4, 0);
 }
 
-/// A dry torque growing with time (3.6e-4 N·m/s, the departure survey's draw 0 at
-/// `DEPARTURE_SEED=5`, on a drawn design whose validate runs all come to rest under the shaker)
-/// was named a 0.21 ms `accel_delay` (ΔBIC −31.2, refit 0.24 ms): the validate runs' equation
-/// error fell 28.7 % against 24.2 % needed, but every one of their rows lay in the free segments,
-/// where the forcing's lag has no column (it carried 0.0 % of their error). That fall was the
-/// damping's shift when the lag's column joined the identify fit, not the lag seen on the
-/// held-out runs: nothing named, and the words say the torque follows time.
-#[test]
-fn a_growing_dry_torque_is_not_named_a_lag_the_validate_rows_cannot_hold() {
-    let words = named_nothing_and_said("dry_torque_growth", 0, 500_000);
-    assert!(words.contains("follows time"), "{words}");
-}
-
 /// A bearing whose μ differs from run to run (`mu_run_spread` 0.18, the departure survey's
 /// draw 4 at `DEPARTURE_SEED=4`): on the second look a breakaway refitted at 9.2e-4 N·m with
 /// v_s 1.23 rad/s (past effects.md's typical 0.05–0.5: over most swings a constant dry torque)

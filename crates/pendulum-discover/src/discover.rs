@@ -2275,16 +2275,6 @@ pub fn discover(
         // (1.49e-2, screen 1.17e-2 at ΔBIC −82, refit 1.41e-2) 29.3 % ± 15.4 % against an
         // equation-error fall of 35 % ± 49 %.
         let eq_powered = reach > eq_needed;
-        // A fall confirms the candidate only where its own columns carry something of the
-        // validate rows' error: the smallest fall ever counted (`eq_gain_min`). Where they carry
-        // less, a fall is the other terms' shift when the candidate's column joined the identify
-        // fit, not the candidate seen on runs the fit never saw. A dry torque growing with time
-        // (outside the catalogue) was named a 0.21 ms accelerometer lag on a validate fall of
-        // 28.7 % (24.2 % needed) whose rows all lay in the free segments, where the forcing's
-        // lag has no column (it carried 0.0 % of them); the validate runs' E_θ moved −164 % ±
-        // 230 %.
-        let eq_carries = reach >= cfg.eq_gain_min;
-        let eq_confirms = eq_gain > eq_needed && eq_carries;
         let mut ci = (est - 1.96 * se, est + 1.96 * se);
         // A shaped effect's size is known only as well as its shape's profile allows.
         if let Some((lo, hi)) = c.size_band.filter(|_| !nonlinear) {
@@ -2338,12 +2328,15 @@ pub fn discover(
             let (g, n) = heldout_gain(&none, &val);
             Ok(g.abs() <= n)
         };
-        let blind =
-            !silent && !e_theta_alone && eq_confirms && gain <= -noise && e_theta_blind(&val_runs)?;
+        let blind = !silent
+            && !e_theta_alone
+            && eq_gain > eq_needed
+            && gain <= -noise
+            && e_theta_blind(&val_runs)?;
         let held_out = if silent {
-            gain > gain_needed && eq_confirms
+            gain > gain_needed && eq_gain > eq_needed
         } else {
-            e_theta_alone || (eq_confirms && (gain > -noise || blind))
+            e_theta_alone || (eq_gain > eq_needed && (gain > -noise || blind))
         };
         // The refitted value of the effect's size.
         let refit_est = size_index.map_or(f64::NAN, |i| refit_x[i]);
@@ -2514,7 +2507,7 @@ pub fn discover(
             let passes = plausible
                 && (informative || shape_views_agree)
                 && gain > SECOND_LOOK_GAIN_FACTOR * gain_needed
-                && (eq_confirms || shape_views_agree || (unpins && !eq_rises));
+                && (eq_gain > eq_needed || shape_views_agree || (unpins && !eq_rises));
             second.record(&c.effect, passes, gain)
         } else {
             plausible && excludes_zero && sc.delta_bic < cfg.screen_threshold && held_out
@@ -2767,13 +2760,6 @@ pub fn discover(
                 100.0 * reach
             ));
         }
-        if eq_gain > eq_needed && !eq_carries {
-            row.note.push_str(&format!(
-                "; the validate runs' equation error falls {:.1} %, but the candidate's own columns carry {:.1} % of it: the fall is the other terms' shift, not a confirmation",
-                100.0 * eq_gain,
-                100.0 * reach
-            ));
-        }
         if shaped_by_trajectories && !second_look {
             row.note.push_str(&format!(
                 "; a shaped effect: the estimate is the trajectory refit's, the value the held-out runs judged (the screen's {est:.4e} {unit}, at its profile's shape)"
@@ -2790,7 +2776,7 @@ pub fn discover(
             ));
         }
         if let Some((shape, e, s, g, _)) = at_trajectories_shape
-            .filter(|_| accepted && shape_views_agree && !(informative && eq_confirms))
+            .filter(|_| accepted && shape_views_agree && !(informative && eq_gain > eq_needed))
         {
             row.note.push_str(&format!(
                 "; at the trajectories' shape ({shape:.4}) the identify runs' equation error holds it at {e:.4e} ± {:.4e} {unit} and the validate runs' falls {:.1} %: the two views on the identify runs agree",
@@ -2798,7 +2784,7 @@ pub fn discover(
                 100.0 * g
             ));
         }
-        if accepted && second_look && unpins && !eq_confirms {
+        if accepted && second_look && unpins && eq_gain <= eq_needed {
             row.note.push_str(
                 "; with it the base parameters' refit leaves the bounds that pinned the base fit",
             );
