@@ -1344,7 +1344,8 @@ const STILL_TAIL_STEPS: f64 = 2.0;
 /// angle rounded outward makes the true friction slide a few mrad in every 0.5 s segment of the
 /// tail, and a larger one stick (a hidden bearing_load_base_accel with μ = 0.1525 was refitted
 /// at 0.190 on a drawn design, ten still segments of one run deciding it). The motion before
-/// the rest, including the stop itself, stays.
+/// the rest, the stop itself and the rest of the segment the stop falls in stay: cut at the
+/// stop, a model that slid on past it was never charged, and a breakaway's refits ran low.
 fn without_still_tail(run: &PreparedRun) -> PreparedRun {
     let step = quantisation_step(&run.theta);
     if !step.is_finite() || run.theta.is_empty() {
