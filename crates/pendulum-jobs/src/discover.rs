@@ -307,7 +307,7 @@ fn run_unmarked(job: &DiscoverJob) -> Result<DiscoverSummary, JobError> {
             f(
                 rows.iter().map(|r| r.estimate).collect(),
                 "estimate",
-                "see column unit",
+                "see column unit (a named effect's value on every run, identify and validate, by the view that named it; otherwise the identify runs')",
             ),
             f(
                 rows.iter().map(|r| r.identify_estimate).collect(),
