@@ -377,6 +377,33 @@ impl View {
         }
     }
 
+    /// Each identify run's encoder zeroing contrast under `fit` (its zero less the runs'
+    /// weighted mean, rad; the reference run's from the constraint Σ w c = 0) and the weights,
+    /// in the order of the runs ([`crate::weak::add_zero_error_contrasts`]). `None` where the
+    /// fit does not hold them.
+    fn zero_contrasts(&self, fit: &crate::screen::Ols) -> Option<(Vec<f64>, Vec<f64>)> {
+        let id_idx: Vec<usize> = (0..self.weak_runs.len())
+            .filter(|&i| {
+                self.weak_runs[i].1 == Role::Identify && self.weak.iter().any(|r| r.run == i)
+            })
+            .collect();
+        let (w, reference) = crate::weak::zero_weights(&self.weak, &id_idx)?;
+        let others: Vec<usize> = (0..id_idx.len()).filter(|&j| j != reference).collect();
+        if others.len() != self.zero_cols.len() {
+            return None;
+        }
+        let mut c = vec![0.0; id_idx.len()];
+        for (&j, &col) in others.iter().zip(&self.zero_cols) {
+            c[j] = fit.coef_of(col)?.0;
+        }
+        let w_ref = w[reference];
+        c[reference] = -others
+            .iter()
+            .map(|&j| if w_ref > 0.0 { w[j] / w_ref } else { 1.0 } * c[j])
+            .sum::<f64>();
+        Some((c, w))
+    }
+
     /// Writes a shape into the shaped column `col` of every row of the view.
     fn set_shape(&mut self, col: usize, value: f64) {
         crate::weak::set_shape(&mut self.weak, col, value);
@@ -1625,14 +1652,16 @@ fn pooled_screen_estimate(
     kind: Kind,
     start: f64,
 ) -> Option<(f64, f64)> {
-    let fit_on = |corr: &Correction| -> Option<(f64, f64)> {
+    // The value, its standard error, and the runs' zeroing-error contrasts with their weights.
+    let fit_on = |corr: &Correction| -> Option<(f64, f64, Option<(Vec<f64>, Vec<f64>)>)> {
         let mut v = View::build_pooled(ctx, alignments, base, cfg, corr);
         if let Some(sh) = c.shaped() {
             v.set_shape(sh.col, c.shape);
         }
         let f = ols(&v.id_rows, &v.columns_from(cols, from))?;
         let (e, se, _) = to_si(c, &f);
-        (e.is_finite() && se.is_finite()).then_some((e, se))
+        let zeros = v.zero_contrasts(&f);
+        (e.is_finite() && se.is_finite()).then_some((e, se, zeros))
     };
     let mut corr = correction.clone();
     let set = |corr: &mut Correction, v: f64| match kind {
@@ -1640,20 +1669,47 @@ fn pooled_screen_estimate(
         _ => corr.delay_s = v,
     };
     if !matches!(kind, Kind::Observation | Kind::Input) {
-        return fit_on(&corr);
+        return fit_on(&corr).map(|(e, se, _)| (e, se));
     }
     // The corrected view's column holds what is left of the effect (as on the identify rows).
-    let (mut est, mut se) = (start, f64::NAN);
+    let (mut est, mut se, mut zeros) = (start, f64::NAN, None);
     for _ in 0..3 {
         set(&mut corr, est);
-        let (step, s) = fit_on(&corr)?;
+        let (step, s, z) = fit_on(&corr)?;
         est += step;
         se = s;
+        zeros = z;
         if step.abs() < 1e-3 * est.abs() {
             break;
         }
     }
+    if let Some((c, w)) = zeros.filter(|_| matches!(kind, Kind::Observation)) {
+        se = with_zeroing_scatter(se, &c, &w);
+    }
     Some((est, se))
+}
+
+/// The standard error of a common encoder offset once each run's own zeroing error is counted
+/// as the draw it is. The offset column estimates the runs' zeros' weighted mean (weights `w`,
+/// the constraint of [`crate::weak::add_zero_error_contrasts`]), and each run's zero sits a few
+/// counts from the offset itself (rig.md: zeroed by hand at power-on); the regression holds
+/// those as nuisance contrasts, so its standard error `se` says how well the mean of these
+/// runs' zeros is known, not how far it may sit from the offset. From the contrasts `c` (each
+/// run's zero less the mean, Σ w c = 0): the zeros' variance s² = Σ w c² / (Σw − Σw²/Σw), the
+/// weighted mean's s² Σw²/(Σw)², whose t(n−1) multiple joins the 95 % half-width; returned as
+/// a standard error (÷ 1.96). On the every-effect survey's offsets (`SURVEY_SEED=7` and `8`,
+/// e87ff42) the regression's intervals were ±0.1–0.2 % wide and held none of the nine truths
+/// printed, which sat 0.2–4.3 % away.
+fn with_zeroing_scatter(se: f64, c: &[f64], w: &[f64]) -> f64 {
+    let n = c.len();
+    let (sw, sw2) = (w.iter().sum::<f64>(), w.iter().map(|v| v * v).sum::<f64>());
+    let dof_w = sw - sw2 / sw;
+    if n < 2 || n != w.len() || !(dof_w > 0.0) {
+        return se;
+    }
+    let s2 = c.iter().zip(w).map(|(c, w)| w * c * c).sum::<f64>() / dof_w;
+    let half_z = t95(n - 1) * (s2 * sw2 / (sw * sw)).sqrt();
+    ((1.96 * se).powi(2) + half_z.powi(2)).sqrt() / 1.96
 }
 
 /// A named effect's trajectory refit on every run, identify and validate: the identify runs'
@@ -3617,6 +3673,28 @@ mod tests {
             "{}",
             row.note
         );
+    }
+
+    /// The zeroing scatter's share of an offset's interval, by hand: four runs of equal weight
+    /// whose zeros sit ±2 counts from their mean (s² = 16/3 counts², the mean's s²/4, t(3) =
+    /// 3.182) widen a 0.1-count standard error to √((1.96·0.1)² + 3.182² · 4/3)/1.96 counts;
+    /// weights change the mean's share (Σw²/(Σw)²); a lone run changes nothing.
+    #[test]
+    fn an_offsets_interval_counts_each_runs_zeroing_error() {
+        let count = std::f64::consts::TAU / 4096.0;
+        let se = 0.1 * count;
+        assert_eq!(with_zeroing_scatter(se, &[count], &[1.0]), se);
+        let c = [2.0 * count, -2.0 * count, 2.0 * count, -2.0 * count];
+        let want =
+            ((1.96 * se).powi(2) + 3.1824_f64.powi(2) * 4.0 / 3.0 * count * count).sqrt() / 1.96;
+        let got = with_zeroing_scatter(se, &c, &[1.0; 4]);
+        assert!((got / want - 1.0).abs() < 1e-3, "{got} vs {want}");
+        // Weights 3, 1, 1, 1 (Σ w c = 0 with c = 1, −1, −1, −1 counts): s² = 6 / (6 − 12/6)
+        // = 1.5, the mean's s² · 12/36 = 0.5 counts².
+        let c = [count, -count, -count, -count];
+        let want = ((1.96 * se).powi(2) + 3.1824_f64.powi(2) * 0.5 * count * count).sqrt() / 1.96;
+        let got = with_zeroing_scatter(se, &c, &[3.0, 1.0, 1.0, 1.0]);
+        assert!((got / want - 1.0).abs() < 1e-3, "{got} vs {want}");
     }
 
     /// Rows whose target holds a known torque column plus noise: the candidate's reach (the fall

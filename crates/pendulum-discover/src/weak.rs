@@ -316,19 +316,7 @@ pub fn add_zero_error_contrasts(rows: &mut [WeakRow], identify_runs: &[usize]) -
     let Some(offset) = observation_column() else {
         return Vec::new();
     };
-    let mut info: Vec<f64> = identify_runs
-        .iter()
-        .map(|&q| zero_information(rows, q, offset))
-        .collect();
-    if info.iter().all(|w| *w <= 0.0) {
-        info.iter_mut().for_each(|w| *w = 1.0);
-    }
-    // The best-informed run is the reference (on a tie, the first: `max_by` keeps the last of the
-    // reversed order).
-    let Some(reference) = (0..identify_runs.len())
-        .rev()
-        .max_by(|&a, &b| info[a].total_cmp(&info[b]))
-    else {
+    let Some((info, reference)) = zero_weights(rows, identify_runs) else {
         return Vec::new();
     };
     let others: Vec<usize> = (0..identify_runs.len())
@@ -354,6 +342,26 @@ pub fn add_zero_error_contrasts(rows: &mut [WeakRow], identify_runs: &[usize]) -
         r.x.extend(extra);
     }
     (width..width + others.len()).collect()
+}
+
+/// The weights of [`add_zero_error_contrasts`]' constraint, one per run of `identify_runs`
+/// (the information each run's rows hold on its own zero, [`zero_information`]; all 1 where
+/// none holds any), and the index among them of the reference run (the best-informed; on a tie,
+/// the first). `None` without runs or without the offset column.
+pub fn zero_weights(rows: &[WeakRow], identify_runs: &[usize]) -> Option<(Vec<f64>, usize)> {
+    let offset = observation_column()?;
+    let mut info: Vec<f64> = identify_runs
+        .iter()
+        .map(|&q| zero_information(rows, q, offset))
+        .collect();
+    if info.iter().all(|w| *w <= 0.0) {
+        info.iter_mut().for_each(|w| *w = 1.0);
+    }
+    // (`max_by` keeps the last of the reversed order.)
+    let reference = (0..identify_runs.len())
+        .rev()
+        .max_by(|&a, &b| info[a].total_cmp(&info[b]))?;
+    Some((info, reference))
 }
 
 /// The information run `run`'s rows hold on the run's own encoder zero: the part of the offset
