@@ -216,6 +216,9 @@ struct Correction {
     shapes: std::collections::BTreeMap<usize, f64>,
 }
 
+/// Each identify run's encoder zeroing contrast (rad) and its weight ([`View::zero_contrasts`]).
+type ZeroContrasts = (Vec<f64>, Vec<f64>);
+
 /// The weak-form equation-error view of a campaign: its rows (with per-run zeroing-error
 /// contrasts and regression weights), which run each belongs to, and the identify and validate
 /// subsets.
@@ -381,7 +384,7 @@ impl View {
     /// weighted mean, rad; the reference run's from the constraint Σ w c = 0) and the weights,
     /// in the order of the runs ([`crate::weak::add_zero_error_contrasts`]). `None` where the
     /// fit does not hold them.
-    fn zero_contrasts(&self, fit: &crate::screen::Ols) -> Option<(Vec<f64>, Vec<f64>)> {
+    fn zero_contrasts(&self, fit: &crate::screen::Ols) -> Option<ZeroContrasts> {
         let id_idx: Vec<usize> = (0..self.weak_runs.len())
             .filter(|&i| {
                 self.weak_runs[i].1 == Role::Identify && self.weak.iter().any(|r| r.run == i)
@@ -1653,7 +1656,7 @@ fn pooled_screen_estimate(
     start: f64,
 ) -> Option<(f64, f64)> {
     // The value, its standard error, and the runs' zeroing-error contrasts with their weights.
-    let fit_on = |corr: &Correction| -> Option<(f64, f64, Option<(Vec<f64>, Vec<f64>)>)> {
+    let fit_on = |corr: &Correction| -> Option<(f64, f64, Option<ZeroContrasts>)> {
         let mut v = View::build_pooled(ctx, alignments, base, cfg, corr);
         if let Some(sh) = c.shaped() {
             v.set_shape(sh.col, c.shape);
