@@ -1684,6 +1684,8 @@ fn survey_issue_5_every_effect() {
     let (mut hits, mut total, mut within) = (0, 0, 0);
     // Misses whose truth the validate runs cannot confirm either (see `truth_heldout_view`).
     let mut beyond = 0;
+    // Named values whose interval holds the truth, of those named.
+    let (mut holding, mut named_intervals) = (0, 0);
     // `SURVEY_SIZE_SCALE=0.4` draws every size at 0.4 times the catalogue's survey range.
     let size_scale: f64 = std::env::var("SURVEY_SIZE_SCALE")
         .ok()
@@ -1733,9 +1735,19 @@ fn survey_issue_5_every_effect() {
             let cfg = pendulum_discover::DiscoverConfig::default();
             let unconfirmable = truth_view.is_some_and(|(g, n)| g <= cfg.gain_min.max(n));
             beyond += usize::from(unconfirmable && !(hit && ok_est));
+            // Does the named value's own 95 % interval hold the truth? (Counted, not asserted:
+            // an interval may miss one draw in twenty.)
+            let holds = row.is_some_and(|r| r.ci_low <= truth && truth <= r.ci_high);
+            if hit {
+                named_intervals += 1;
+                holding += usize::from(holds);
+            }
             eprintln!(
-                "survey-every {effect} k={k} truth={truth:.4e} estimate={est:.4e} ({:+.1} %){} gain={:.1} % ± {:.1} % eq={:.1} % accepted={accepted:?} unexplained={}{}",
+                "survey-every {effect} k={k} truth={truth:.4e} estimate={est:.4e} ({:+.1} %) interval=[{:.4e}, {:.4e}]{}{} gain={:.1} % ± {:.1} % eq={:.1} % accepted={accepted:?} unexplained={}{}",
                 100.0 * (est / truth - 1.0),
+                row.map_or(f64::NAN, |r| r.ci_low),
+                row.map_or(f64::NAN, |r| r.ci_high),
+                if holds { " holds the truth" } else { "" },
                 row.filter(|r| r.refit_ci_low.is_finite()).map_or(String::new(), |r| format!(
                     " trajectories' range [{:+.0} %, {:+.0} %]",
                     100.0 * (r.refit_ci_low / truth - 1.0),
@@ -1755,7 +1767,7 @@ fn survey_issue_5_every_effect() {
         }
     }
     eprintln!(
-        "survey-every: named alone in {hits} of {total}; of those within 10 % {within}; misses whose truth the validate runs cannot confirm either (E_θ): {beyond}"
+        "survey-every: named alone in {hits} of {total}; of those within 10 % {within}; misses whose truth the validate runs cannot confirm either (E_θ): {beyond}; the named value's interval holds the truth in {holding} of {named_intervals}"
     );
     // Pairs: both named, nothing else.
     let pairs = [
