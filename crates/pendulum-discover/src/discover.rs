@@ -278,19 +278,9 @@ impl View {
         Self::build_with(ctx, alignments, base, cfg, correction, false)
     }
 
-    /// The view with every run's rows as identify rows (each run's zeroing-error contrast,
-    /// the weights from all of them): where a named effect's value is estimated on every run
-    /// ([`pooled_screen_estimate`]). Its `val_rows` are empty.
-    fn build_pooled(
-        ctx: &Context,
-        alignments: &std::collections::BTreeMap<String, pendulum_process::Alignment>,
-        base: Base,
-        cfg: &WeakConfig,
-        correction: &Correction,
-    ) -> View {
-        Self::build_with(ctx, alignments, base, cfg, correction, true)
-    }
-
+    /// [`View::build`], or with `pooled` the view with every run's rows as identify rows (each
+    /// run's zeroing-error contrast, the weights from all of them): where a named effect's value
+    /// is estimated on every run ([`pooled_screen_estimate`]); its `val_rows` are then empty.
     fn build_with(
         ctx: &Context,
         alignments: &std::collections::BTreeMap<String, pendulum_process::Alignment>,
@@ -1633,7 +1623,7 @@ fn shape_start(
 }
 
 /// A named effect's value from the equation-error view of every run, identify and validate
-/// ([`View::build_pooled`]): the candidate's columns `cols` (chosen on `from`, with the shape
+/// ([`View::build_with`], pooled): the candidate's columns `cols` (chosen on `from`, with the shape
 /// `c` was judged at), and for an effect applied exactly to the measured motion (an encoder
 /// offset, an accelerometer lag) the same refinement as on the identify rows, starting from
 /// their value `start`. The held-out runs have judged the effect by then; what they add is
@@ -1657,7 +1647,7 @@ fn pooled_screen_estimate(
 ) -> Option<(f64, f64)> {
     // The value, its standard error, and the runs' zeroing-error contrasts with their weights.
     let fit_on = |corr: &Correction| -> Option<(f64, f64, Option<ZeroContrasts>)> {
-        let mut v = View::build_pooled(ctx, alignments, base, cfg, corr);
+        let mut v = View::build_with(ctx, alignments, base, cfg, corr, true);
         if let Some(sh) = c.shaped() {
             v.set_shape(sh.col, c.shape);
         }
