@@ -1691,8 +1691,8 @@ fn pooled_screen_estimate(
 /// run's zero less the mean, Σ w c = 0): the zeros' variance s² = Σ w c² / (Σw − Σw²/Σw), the
 /// weighted mean's s² Σw²/(Σw)², whose t(n−1) multiple joins the 95 % half-width; returned as
 /// a standard error (÷ 1.96). On the every-effect survey's offsets (`SURVEY_SEED=7` and `8`,
-/// e87ff42) the regression's intervals were ±0.1–0.2 % wide and held none of the nine truths
-/// printed, which sat 0.2–4.3 % away.
+/// e87ff42) the regression's intervals were ±0.05–0.15 % wide and held none of the ten truths,
+/// which sat 0.2–4.3 % away; with the scatter all ten hold them.
 fn with_zeroing_scatter(se: f64, c: &[f64], w: &[f64]) -> f64 {
     let n = c.len();
     let (sw, sw2) = (w.iter().sum::<f64>(), w.iter().map(|v| v * v).sum::<f64>());
