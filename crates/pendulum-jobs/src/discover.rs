@@ -258,12 +258,18 @@ fn run_unmarked(job: &DiscoverJob) -> Result<DiscoverSummary, JobError> {
         b.finish_and_clear();
     }
     res?;
-    let (free, left_out) = identify_free_segments(&ctx, &stages, &pipe.discover);
+    let (free, left_out) = free_segments(&ctx, &stages, &pipe.discover);
     ctx.notes.extend(left_out);
-    if !free.is_empty() {
+    let n_id = free.iter().filter(|r| r.role == Role::Identify).count();
+    if n_id > 0 {
         ctx.notes.push(format!(
-            "the trajectory refits also follow the free segment before the shaker starts of {} identify run(s) (one at rest adds nothing)",
-            free.len()
+            "the trajectory refits also follow the free segment before the shaker starts of {n_id} identify run(s) (one at rest adds nothing)"
+        ));
+    }
+    let n_val = free.len() - n_id;
+    if n_val > 0 {
+        ctx.notes.push(format!(
+            "the held-out E_θ also follows the free segment before the shaker starts of {n_val} validate run(s), and a named effect's value refitted on every run follows them too (one at rest adds nothing)"
         ));
     }
     let d = discover(&ctx, job.base, &pipe.discover, &free)?;
@@ -1346,21 +1352,19 @@ fn write_report(
     })
 }
 
-/// The identify runs' free segments before their shakers start (at least
+/// Every run's free segment before its shaker starts (at least
 /// [`crate::identify::FREE_SEGMENT_MIN_S`]), aligned, started and prepared as free decays by the
 /// pipeline's own stages (not its fit), then as runs of the shaker model with the crank still
 /// ([`pendulum_process::fit::PreparedRun::unforced`]): discover's trajectory refits see the
-/// damping over the run's widest swings. A segment the stages cannot read, or whose preparation
+/// damping over the identify runs' widest swings, and a named effect's value refitted on every
+/// run sees the validate runs' too. A segment the stages cannot read, or whose preparation
 /// fails, is left out (the second value: a note per segment the stages refused).
-fn identify_free_segments(
+pub fn free_segments(
     ctx: &Context,
     stages: &PipelineConfig,
     cfg: &DiscoverConfig,
 ) -> (Vec<pendulum_process::fit::PreparedRun>, Vec<String>) {
-    let runs: Vec<_> = crate::identify::free_segment_runs(ctx)
-        .into_iter()
-        .filter(|r| r.role == Role::Identify)
-        .collect();
+    let runs = crate::identify::free_segment_runs(ctx);
     let (kept, left_out) = crate::identify::prepared_free_segments(runs, stages);
     let mut out = Vec::new();
     for fctx in &kept {
