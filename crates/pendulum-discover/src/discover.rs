@@ -2056,10 +2056,11 @@ fn anova(key: &[f64], res: &[f64], bins: usize) -> Option<(f64, f64)> {
 }
 
 /// Runs discovery on a context whose pipeline has aligned the runs, estimated initial states and
-/// steady states, and fitted the base model (`ctx.fits[0]`). `free_segments`: the identify runs'
-/// free segments before their shakers start, as runs of the shaker model with the crank still
-/// ([`PreparedRun::unforced`]; others are ignored); every trajectory refit follows the moving
-/// ones beside the forced windows.
+/// steady states, and fitted the base model (`ctx.fits[0]`). `free_segments`: the runs' free
+/// segments before their shakers start, as runs of the shaker model with the crank still
+/// ([`PreparedRun::unforced`]; others are ignored): every trajectory refit follows the identify
+/// runs' moving ones beside the forced windows, and the held-out E_θ the validate runs'
+/// ([`held_out_runs`]).
 pub fn discover(
     ctx: &Context,
     base: Base,
