@@ -2567,6 +2567,11 @@ pub fn discover(
         };
         // The best of the current model's validations (as fitted, refitted locally, and
         // refitted from the candidate's refit without the effect).
+        // (Each on the runs that judge the candidate, [`judged_for`]: chosen on the free
+        // segments' E_θ too, a baseline that did better there beat one that did better on the
+        // forced windows of an effect the free segments do not judge, and a cable anchored to
+        // one side was named an encoder offset on the gain over the worse one.)
+        let judged_total = |v: &[RunFit]| e_total(&judged_for(effect, v, &free_moving_val));
         let before_val = [
             Some(&current_val),
             Some(&current_refit_val),
@@ -2574,19 +2579,17 @@ pub fn discover(
         ]
         .into_iter()
         .flatten()
-        .min_by(|a, b| e_total(a).total_cmp(&e_total(b)))
+        .min_by(|a, b| judged_total(a).total_cmp(&judged_total(b)))
         .unwrap_or(&current_val);
-        let before = e_total(before_val);
-        let after = e_total(&val);
+        let val_judged = judged_for(effect, &val, &free_moving_val);
+        let before_judged = judged_for(effect, before_val, &free_moving_val);
+        let before = e_total(&before_judged);
+        let after = e_total(&val_judged);
         // A torque that vanishes at rest (a loss that sets no sticking capacity) is judged where
         // the pendulum moves ([`heldout_gain_in_motion`]).
         let only_in_motion = effect.kind() == Kind::Dynamics
             && effect.positive()
             && !effect.sets_sticking_capacity();
-        let (before_judged, val_judged) = (
-            judged_for(effect, before_val, &free_moving_val),
-            judged_for(effect, &val, &free_moving_val),
-        );
         let (gain, noise) = if only_in_motion {
             heldout_gain_in_motion(&before_judged, &val_judged, &held_runs)
         } else {
