@@ -319,6 +319,7 @@ fn regression_issue_5_finds_position_torque() {
 /// k ≤ 4 only, and a hidden k = 8 cogging (0.03 N·m) came out as `unexplained` (θ mod 2π) with
 /// nothing named. Now k is screened up to 64; here k, T_p, φ_p and the design are drawn.
 #[test]
+#[ignore = "slow set (one fixed twin draw, the every-effect survey draws five): the default suite finds a cogging torque on independent::issue_12_independent_i03_position_torque and in a_run_zeroed_off_by_counts_does_not_hide_a_cogging_torque; README, Tests"]
 fn regression_issue_12_finds_motor_cogging() {
     let mut r = rng(12_024);
     let k: u32 = r.random_range(6..=64);

@@ -141,6 +141,7 @@ fn regression_issue_14_mislabelled_encoder_is_unexplained() {
 /// a fit with position torques up to k = 64 its validate runs did not confirm it at all (fall
 /// 30 % against a noise of 37 %), and then nothing was named and nothing said.
 #[test]
+#[ignore = "slow set (four drawn growths, 66 s on 2 cores beside another test; the departure survey draws five): the default suite checks the same on a_fast_growing_dry_torque_is_not_named_a_constant_one (nothing named, following time, the t sgn θ̇ rate within 25 %) and a_growing_dry_torque_is_not_credited_with_the_damping_its_refit_repairs; README, Tests"]
 fn regression_issue_12_growing_dry_torque_is_unexplained() {
     let mut r = rng(3);
     let mut described = 0;
@@ -267,6 +268,7 @@ fn friction_that_differs_from_run_to_run_names_nothing() {
 /// `unexplained` following θ (unwrapped), "linear in the unwrapped θ (a spring), cubic", the
 /// linear term 0.17 N·m/rad; one refused `extra_inertia` as impossible (−2.1e-3 kg·m²).
 #[test]
+#[ignore = "slow set (two drawn cables, 66 s on 2 cores beside another test; the departure survey draws five): the default suite checks that a cable is not named and that the words follow θ (unwrapped) on a_cable_anchored_off_the_vertical_is_not_named_an_encoder_offset, and a spring on regression_issue_14_torsion_spring_is_unexplained; README, Tests"]
 fn slack_cable_is_unexplained_and_follows_the_angle() {
     let mut r = rng(6);
     for case in 0..2 {
@@ -346,6 +348,7 @@ fn a_bouncing_bob_is_unexplained_and_follows_the_rate() {
 /// 62 % of how far its angle moved (now: "the model in hand does not follow runs r08"; 0.06–8.5 %
 /// on campaigns with nothing hidden or with run-to-run friction).
 #[test]
+#[ignore = "slow set (two drawn designs, 33 s on 2 cores beside another test; the departure survey draws encoders 2–8 % off): the default suite checks a mislabelled encoder on regression_issue_14_mislabelled_encoder_is_unexplained and an_encoder_under_its_header_is_not_named_an_inertia_the_refit_cannot_reach; README, Tests"]
 fn encoder_at_twice_its_counts_is_unexplained() {
     let mut r = rng(7);
     for case in 0..2 {
