@@ -485,6 +485,7 @@ fn survey_issue_5_false_alarm_rate() {
 /// 6.2 % ± 2.5 % that refitting the other parameters along it had made. The trajectories, the
 /// view that sees a dry torque on the second look, must tell it from its absence.
 #[test]
+#[ignore = "slow set (campaign 9 of the false-alarm survey at SURVEY_SEED=1, which draws it again): the default suite checks that nothing is named with nothing hidden on nothing_hidden_from_the_reference_base_on_a_mostly_resting_design_names_nothing and independent::issue_12_independent_i00_none, i01 and i11; README, Tests"]
 fn a_dry_torque_refitted_to_nothing_is_not_named_on_the_second_look() {
     let off = 100_000;
     let mut r = rng(40 + off);
@@ -526,6 +527,7 @@ fn a_dry_torque_is_not_credited_with_what_a_better_start_gives_the_base() {
 /// inside their bound. From the initial states the model follows, the truth scores E_θ 0.32
 /// against 14.4 and the refit stays near it.) Its offset is also within the score's 2 mrad.
 #[test]
+#[ignore = "slow set (a survey draw: `encoder_offset` k=0 at SURVEY_SEED=1, 51 s): the default suite names offsets on a_named_offsets_interval_counts_each_runs_zeroing_error, an_offset_that_changes_which_runs_have_windows_does_not_break_the_screen and independent::issue_12_independent_i06_encoder_offset; README, Tests"]
 fn an_offset_the_base_fit_mistakes_for_sticking_is_named_on_the_second_look() {
     let off = 100_000;
     let e_idx = 8; // encoder_offset's place in the survey's order
@@ -899,6 +901,7 @@ fn an_accepted_effect_is_not_judged_again_by_a_later_round() {
 /// trajectories about as well. On the second look the trajectories are the view that found the
 /// effect, so the screen's interval must hold their value: a miss, not a wrong name.
 #[test]
+#[ignore = "slow set (a survey draw: `position_torque` k=1 at SURVEY_SEED=2, 43 s): the default suite names cogging torques on an_accepted_effect_is_not_judged_again_by_a_later_round and independent::issue_12_independent_i03_position_torque, and refuses a refit set apart from its screen on a_breakaway_whose_refit_runs_its_speed_scale_to_the_range_end_is_not_named_there; README, Tests"]
 fn a_second_look_refit_outside_the_screens_interval_is_not_named() {
     let s = discover(
         205_501,
@@ -1107,6 +1110,7 @@ fn a_many_lobed_torque_is_not_refused_for_its_aliased_column_on_a_fast_run() {
 /// position torque beside it (held-out E_θ −6.3 %). With the zeroing error held as a nuisance
 /// before any effect is judged, the tilt is named alone.
 #[test]
+#[ignore = "slow set (a survey draw: `horizontal_base` k=4 at SURVEY_SEED=1): the default suite names a tilt on independent::issue_12_independent_i04_horizontal_base and in a pair on independent::issue_12_independent_i10_pair; README, Tests"]
 fn a_tilt_met_before_the_runs_zeroing_error_is_named_alone() {
     let truth = -0.07866408049218221;
     let s = discover(
@@ -1174,6 +1178,7 @@ fn nothing_hidden_from_the_reference_base_on_a_mostly_resting_design_names_nothi
 /// its refit, the model the validate runs' E_θ judged, said 9.88e-3 (−7.3 %). A shaped effect's
 /// named value is its refit's.
 #[test]
+#[ignore = "slow set (a survey draw: `stribeck` k=4 at SURVEY_SEED=0): the default suite sizes a named breakaway on a_named_breakaway_is_sized_on_every_runs_trajectories; README, Tests"]
 fn a_breakaway_whose_equation_error_confirms_the_screen_is_named_at_its_refits_size() {
     let truth = 0.010651545899594952;
     let s = discover(
@@ -1353,6 +1358,7 @@ fn small_speed_drift_is_confirmed_by_the_validate_runs_crank_tracks() {
 /// trajectories, whose drift is the accelerometers' and not fitted to them, say the pendulum
 /// feels it (without it, the damping refitted, their error rises 1100 %). Named alone, within 1 %.
 #[test]
+#[ignore = "slow set (a survey draw: `speed_drift` k=1 of the 0.4 × survey): the default suite names drifts on small_speed_drift_is_confirmed_by_the_validate_runs_crank_tracks and independent::issue_12_independent_i08_speed_drift; README, Tests"]
 fn resting_validate_runs_do_not_veto_a_drift_the_identify_runs_feel() {
     let (truth, spec, base, a, b, mu) = draw_scaled("speed_drift", &mut rng(2101), 0.4);
     let s = discover(6101, base, a, b, mu, &spec);
@@ -1444,6 +1450,7 @@ fn a_breakaway_whose_refit_runs_its_speed_scale_to_the_range_end_is_not_named_th
 /// want of twice the E_θ bar. A view that cannot see a candidate neither confirms nor contradicts
 /// it: named within 10 %, the row saying why E_θ judged it alone.
 #[test]
+#[ignore = "slow set (a survey draw: `stribeck` k=0 at SURVEY_SEED=7): the default suite names breakaways on a_breakaway_is_judged_on_the_validate_runs_free_segments_too and a_named_breakaway_is_sized_on_every_runs_trajectories, and a lag the E_θ cannot see on a_lag_the_validate_runs_e_theta_cannot_see_is_judged_on_their_equation_error; README, Tests"]
 fn a_breakaway_the_validate_runs_equation_error_cannot_see_is_judged_on_their_trajectories() {
     let (truth, spec, base, a, b, mu) = draw_scaled("stribeck", &mut rng(702_200), 1.0);
     let s = discover(706_200, base, a, b, mu, &spec);
@@ -1468,6 +1475,7 @@ fn a_breakaway_the_validate_runs_equation_error_cannot_see_is_judged_on_their_tr
 /// 1.12e-2 ± 0.35e-2, beside a constant dry torque too: the two views on the identify runs agree,
 /// and it is named within 10 %, the row saying why.
 #[test]
+#[ignore = "slow set (a survey draw: `stribeck` k=4 at SURVEY_SEED=7): the default suite names breakaways on a_breakaway_is_judged_on_the_validate_runs_free_segments_too and a_named_breakaway_is_sized_on_every_runs_trajectories, and refuses one whose views disagree on a_breakaway_whose_refit_runs_its_speed_scale_to_the_range_end_is_not_named_there; README, Tests"]
 fn a_breakaway_both_identify_views_size_alike_at_the_trajectories_shape_is_named() {
     let (truth, spec, base, a, b, mu) = draw_scaled("stribeck", &mut rng(702_204), 1.0);
     let s = discover(706_204, base, a, b, mu, &spec);
@@ -1489,6 +1497,7 @@ fn a_breakaway_both_identify_views_size_alike_at_the_trajectories_shape_is_named
 /// the truth's size scored 2.872 and a refit from it stayed at 8.40e-3. The shape is chosen again
 /// once the zeros are held: named within 10 %.
 #[test]
+#[ignore = "slow set (a survey draw: `stribeck` k=4 at SURVEY_SEED=8): the default suite names breakaways on a_breakaway_is_judged_on_the_validate_runs_free_segments_too and a_named_breakaway_is_sized_on_every_runs_trajectories, and holds each run's zeroing error on a_named_offsets_interval_counts_each_runs_zeroing_error; README, Tests"]
 fn a_breakaway_shape_is_chosen_again_once_each_runs_zeroing_error_is_held() {
     let (truth, spec, base, a, b, mu) = draw_scaled("stribeck", &mut rng(802_204), 1.0);
     let s = discover(806_204, base, a, b, mu, &spec);
@@ -1523,6 +1532,7 @@ fn a_breakaway_is_judged_on_the_validate_runs_free_segments_too() {
 /// ones. With the validate runs' free segments in it, named within 10 %, the report saying how
 /// many joined.
 #[test]
+#[ignore = "slow set (a survey draw: `stribeck` k=0 of the every-effect survey at SURVEY_SEED=8 draws it again): the default suite checks that a breakaway is judged on the validate runs' free segments on a_breakaway_is_judged_on_the_validate_runs_free_segments_too, and sized on every run on a_named_breakaway_is_sized_on_every_runs_trajectories; README, Tests"]
 fn a_named_breakaway_is_refitted_on_the_validate_runs_free_segments_too() {
     let (truth, spec, base, a, b, mu) = draw_scaled("stribeck", &mut rng(802_200), 1.0);
     let s = discover(806_200, base, a, b, mu, &spec);

@@ -45,51 +45,75 @@ fn rng(tag: u64) -> rand_chacha::ChaCha8Rng {
     rand_chacha::ChaCha8Rng::seed_from_u64(0x1414_0000 + tag)
 }
 
+/// The `case`-th value `draw` makes from [`rng`]`(tag)`, after the `case` draws before it: a
+/// multi-draw test's draws, one test each, as they were when one test looped over them.
+fn nth_draw<T>(tag: u64, case: u64, draw: impl Fn(&mut rand_chacha::ChaCha8Rng) -> T) -> T {
+    let mut r = rng(tag);
+    for _ in 0..case {
+        draw(&mut r);
+    }
+    draw(&mut r)
+}
+
 /// A cable acting as a linear torsion spring (−k θ, θ unwrapped): `position_torque` k = 1 fits
 /// it on small swings (sin θ ≈ θ), but it is not the cause. The answer must be `unexplained`,
 /// following the unwrapped θ, linear, with k within 10 %, and nothing named.
 #[test]
 fn regression_issue_14_torsion_spring_is_unexplained() {
-    let mut r = rng(1);
-    for case in 0..2 {
-        let k = r.random_range(0.05..0.15);
-        let (b, mu) = (r.random_range(0.3..0.7), r.random_range(0.08..0.2));
-        let s = discover_with(
-            7100 + case,
-            b,
-            mu,
-            &format!("torsion_spring_nm_per_rad = {k}"),
-        );
-        let d = &s.discovery;
-        assert!(
-            d.accepted().is_empty(),
-            "case {case}: named {:?} for a torsion spring",
-            d.accepted()
-        );
-        let desc = d
-            .unexplained_description
-            .as_ref()
-            .unwrap_or_else(|| panic!("case {case}: no description ({:?})", d.unexplained));
-        assert_eq!(desc.variable, Variable::Angle, "case {case}: {desc:?}");
-        // The library's coefficient is the target's (what damping and the effects must
-        // explain), +k θ for a restoring −k θ.
-        let theta = desc
-            .terms
-            .iter()
-            .find(|(j, _, _)| LIBRARY[*j].name == "θ")
-            .unwrap_or_else(|| panic!("case {case}: no linear θ term in {desc:?}"));
-        assert!(
-            (theta.1 - k).abs() < 0.1 * k,
-            "case {case}: spring {:.4e} N·m/rad described as {:.4e}",
-            k,
-            theta.1
-        );
-        let words = d.unexplained.as_deref().unwrap_or_default();
-        assert!(
-            words.contains("θ (unwrapped)") && words.contains("a spring"),
-            "{words}"
-        );
-    }
+    torsion_spring_case(0);
+}
+
+/// [`regression_issue_14_torsion_spring_is_unexplained`]'s second drawn spring.
+#[test]
+#[ignore = "slow set (a second drawn spring; the departure survey draws five): the default suite checks the same on the first draw, regression_issue_14_torsion_spring_is_unexplained, and a weak spring on a_weak_torsion_spring_is_not_named_a_position_torque; README, Tests"]
+fn regression_issue_14_torsion_spring_is_unexplained_second_draw() {
+    torsion_spring_case(1);
+}
+
+/// The `case`-th of the drawn torsion springs (a draw made after the ones before it).
+fn torsion_spring_case(case: u64) {
+    let (k, b, mu) = nth_draw(1, case, |r| {
+        (
+            r.random_range(0.05..0.15),
+            r.random_range(0.3..0.7),
+            r.random_range(0.08..0.2),
+        )
+    });
+    let s = discover_with(
+        7100 + case,
+        b,
+        mu,
+        &format!("torsion_spring_nm_per_rad = {k}"),
+    );
+    let d = &s.discovery;
+    assert!(
+        d.accepted().is_empty(),
+        "case {case}: named {:?} for a torsion spring",
+        d.accepted()
+    );
+    let desc = d
+        .unexplained_description
+        .as_ref()
+        .unwrap_or_else(|| panic!("case {case}: no description ({:?})", d.unexplained));
+    assert_eq!(desc.variable, Variable::Angle, "case {case}: {desc:?}");
+    // The library's coefficient is the target's (what damping and the effects must
+    // explain), +k θ for a restoring −k θ.
+    let theta = desc
+        .terms
+        .iter()
+        .find(|(j, _, _)| LIBRARY[*j].name == "θ")
+        .unwrap_or_else(|| panic!("case {case}: no linear θ term in {desc:?}"));
+    assert!(
+        (theta.1 - k).abs() < 0.1 * k,
+        "case {case}: spring {:.4e} N·m/rad described as {:.4e}",
+        k,
+        theta.1
+    );
+    let words = d.unexplained.as_deref().unwrap_or_default();
+    assert!(
+        words.contains("θ (unwrapped)") && words.contains("a spring"),
+        "{words}"
+    );
 }
 
 /// An encoder whose real counts per revolution (4200–4400) are not the 4096 its header says:
@@ -101,32 +125,46 @@ fn regression_issue_14_torsion_spring_is_unexplained() {
 /// where (θ) without a confirmed shape.
 #[test]
 fn regression_issue_14_mislabelled_encoder_is_unexplained() {
-    let mut r = rng(2);
-    for case in 0..2 {
-        let cpr = r.random_range(4200.0..4400.0);
-        let (b, mu) = (r.random_range(0.3..0.7), r.random_range(0.08..0.2));
-        let s = discover_with(7200 + case, b, mu, &format!("encoder_cpr_true = {cpr}"));
-        let d = &s.discovery;
+    mislabelled_encoder_case(0);
+}
+
+/// [`regression_issue_14_mislabelled_encoder_is_unexplained`]'s second drawn encoder.
+#[test]
+#[ignore = "slow set (a second drawn encoder, 28 s; the departure survey draws encoders 2–8 % off): the default suite checks the same on the first draw, regression_issue_14_mislabelled_encoder_is_unexplained, and an_encoder_under_its_header_is_not_named_an_inertia_the_refit_cannot_reach; README, Tests"]
+fn regression_issue_14_mislabelled_encoder_is_unexplained_second_draw() {
+    mislabelled_encoder_case(1);
+}
+
+/// The `case`-th of the drawn mislabelled encoders (a draw made after the ones before it).
+fn mislabelled_encoder_case(case: u64) {
+    let (cpr, b, mu) = nth_draw(2, case, |r| {
+        (
+            r.random_range(4200.0..4400.0),
+            r.random_range(0.3..0.7),
+            r.random_range(0.08..0.2),
+        )
+    });
+    let s = discover_with(7200 + case, b, mu, &format!("encoder_cpr_true = {cpr}"));
+    let d = &s.discovery;
+    assert!(
+        d.accepted().is_empty(),
+        "case {case}: named {:?} for a mislabelled encoder",
+        d.accepted()
+    );
+    let words = d
+        .unexplained
+        .as_deref()
+        .unwrap_or_else(|| panic!("case {case}: no `unexplained`"));
+    // θ itself, not dθ/dt.
+    assert!(
+        words.contains("θ (unwrapped)") || words.contains("θ (mod 2π)"),
+        "case {case}: {words}"
+    );
+    if let Some(desc) = &d.unexplained_description {
         assert!(
-            d.accepted().is_empty(),
-            "case {case}: named {:?} for a mislabelled encoder",
-            d.accepted()
+            matches!(desc.variable, Variable::Angle | Variable::AngleInTurn),
+            "case {case}: {desc:?}"
         );
-        let words = d
-            .unexplained
-            .as_deref()
-            .unwrap_or_else(|| panic!("case {case}: no `unexplained`"));
-        // θ itself, not dθ/dt.
-        assert!(
-            words.contains("θ (unwrapped)") || words.contains("θ (mod 2π)"),
-            "case {case}: {words}"
-        );
-        if let Some(desc) = &d.unexplained_description {
-            assert!(
-                matches!(desc.variable, Variable::Angle | Variable::AngleInTurn),
-                "case {case}: {desc:?}"
-            );
-        }
     }
 }
 
@@ -241,7 +279,7 @@ fn encoder_backlash_is_unexplained_and_follows_the_rate() {
 /// nothing named on either; one came back `unexplained` (`coulomb_constant` explains only 59 %
 /// of the freer shape in θ̇), the other with nothing said.
 #[test]
-#[ignore = "slow set (two fixed twin draws; the departure survey draws five): the default suite checks the same on a third draw, a_friction_that_differs_from_run_to_run_is_not_named_a_constant_dry_torque (nothing named, the words say the torque follows the run); README, Tests"]
+#[ignore = "slow set (two fixed twin draws; the departure survey draws five): the default suite checks the same on another draw, a_friction_that_differs_on_the_validate_runs_is_not_named_a_generator (nothing named, the words say the torque follows the run); README, Tests"]
 fn friction_that_differs_from_run_to_run_names_nothing() {
     let mut r = rng(5);
     for case in 0..2 {
@@ -609,6 +647,7 @@ fn an_encoder_under_its_header_is_not_named_an_inertia_the_refit_cannot_reach() 
 /// held-out E_θ fall was 3.1 % ± 7.2 %). A switch's trajectory check now compares with the
 /// model without it. Nothing is named, and `unexplained` speaks of dθ/dt.
 #[test]
+#[ignore = "slow set (the departure survey's draw 3 at DEPARTURE_SEED=1, 47 s): the default suite checks a backlash on an_encoder_backlash_is_not_named_an_accelerometer_lead, and a switch the trajectories cannot tell from its absence on a_bearing_load_the_trajectories_cannot_tell_from_its_absence_is_named_at_the_screens_value; README, Tests"]
 fn an_encoder_backlash_is_not_named_a_bearing_load_the_trajectories_cannot_see() {
     let words = named_nothing_and_said("encoder_backlash", 3, 100_000);
     assert!(words.contains("dθ/dt"), "{words}");
@@ -655,6 +694,7 @@ fn a_cable_anchored_off_the_vertical_is_not_named_an_encoder_offset() {
 /// disagreeing beyond twice the bar explains the departure only in part: nothing named, and the
 /// words say the torque follows the run.
 #[test]
+#[ignore = "slow set (the departure survey's draw 0 at DEPARTURE_SEED=3): the default suite checks a friction that differs from run to run on a_friction_that_differs_on_the_validate_runs_is_not_named_a_generator (nothing named, the words say the torque follows the run) and a_run_to_run_friction_is_not_named_a_breakaway_that_is_a_constant_dry_torque; README, Tests"]
 fn a_friction_that_differs_from_run_to_run_is_not_named_a_constant_dry_torque() {
     let words = named_nothing_and_said("mu_run_spread", 0, 300_000);
     assert!(words.contains("follows the run"), "{words}");

@@ -1960,11 +1960,16 @@ fn moving_free_segments(free_segments: &[PreparedRun], role: Role) -> Vec<Prepar
 /// segments, 14.1 % ± 7.0 % against 14.0 %, and it is named. Only such torques are judged there
 /// ([`judged_on_free_segments`]). Public so that a survey can ask the same of the truth itself.
 pub fn held_out_runs(val_runs: &[PreparedRun], free_segments: &[PreparedRun]) -> Vec<PreparedRun> {
-    val_runs
-        .iter()
-        .cloned()
-        .chain(moving_free_segments(free_segments, Role::Validate))
-        .collect()
+    beside(
+        val_runs,
+        &moving_free_segments(free_segments, Role::Validate),
+    )
+}
+
+/// The forced windows `val_runs` and the moving free segments `free_moving_val` (already chosen
+/// by [`moving_free_segments`]) as one list: [`held_out_runs`] for a caller that holds them.
+fn beside(val_runs: &[PreparedRun], free_moving_val: &[PreparedRun]) -> Vec<PreparedRun> {
+    val_runs.iter().chain(free_moving_val).cloned().collect()
 }
 
 /// `v` without the validations of the free segments `free` (by run id): the forced windows.
@@ -2163,7 +2168,7 @@ pub fn discover(
     let first_round = &screened.first_round;
 
     // The held-out runs as the E_θ judgement sees them (forced windows and free segments).
-    let held = |runs: &[PreparedRun]| held_out_runs(runs, free_segments);
+    let held = |runs: &[PreparedRun]| beside(runs, &free_moving_val);
     let mut held_runs = held(&val_runs);
     // The base model on the held-out runs.
     let v1 = validate(&held_runs, &base_fit.spec, &base_fit.params, &cfg.validate)?;
@@ -2571,19 +2576,22 @@ pub fn discover(
         // segments' E_θ too, a baseline that did better there beat one that did better on the
         // forced windows of an effect the free segments do not judge, and a cable anchored to
         // one side was named an encoder offset on the gain over the worse one.)
-        let judged_total = |v: &[RunFit]| e_total(&judged_for(effect, v, &free_moving_val));
-        let before_val = [
+        // (Each judged view built once; `min_by` keeps the first of equals, the fitted model.)
+        let (before_val, before_judged, before) = [
             Some(&current_val),
             Some(&current_refit_val),
             absence_val.as_ref(),
         ]
         .into_iter()
         .flatten()
-        .min_by(|a, b| judged_total(a).total_cmp(&judged_total(b)))
-        .unwrap_or(&current_val);
+        .map(|v| {
+            let judged = judged_for(effect, v, &free_moving_val);
+            let total = e_total(&judged);
+            (v, judged, total)
+        })
+        .min_by(|a, b| a.2.total_cmp(&b.2))
+        .expect("the fitted model's validation is always there");
         let val_judged = judged_for(effect, &val, &free_moving_val);
-        let before_judged = judged_for(effect, before_val, &free_moving_val);
-        let before = e_total(&before_judged);
         let after = e_total(&val_judged);
         // A torque that vanishes at rest (a loss that sets no sticking capacity) is judged where
         // the pendulum moves ([`heldout_gain_in_motion`]).
