@@ -279,6 +279,7 @@ fn pooled_envelope_b_within_5_percent_of_a_linear_base_campaign() {
 }
 
 #[test]
+#[ignore = "slow set (one drawn design): the default suite has the linear base find a loss it lacks on regression_issue_5_linear_base_finds_bearing_friction (the study's headline) and the dry base on regression_issue_5_dry_base_finds_viscous_drag and independent::issue_12_independent_i11_linear_truth_dry; README, Tests"]
 fn regression_issue_5_linear_base_finds_quadratic_drag() {
     let (a, ..) = draw("viscous_quadratic", &mut rng(2));
     let s = found_when_hidden("viscous_quadratic", 2, 111);
@@ -527,7 +528,7 @@ fn a_dry_torque_is_not_credited_with_what_a_better_start_gives_the_base() {
 /// inside their bound. From the initial states the model follows, the truth scores E_θ 0.32
 /// against 14.4 and the refit stays near it.) Its offset is also within the score's 2 mrad.
 #[test]
-#[ignore = "slow set (a survey draw: `encoder_offset` k=0 at SURVEY_SEED=1, 51 s): the default suite names offsets on a_named_offsets_interval_counts_each_runs_zeroing_error, an_offset_that_changes_which_runs_have_windows_does_not_break_the_screen and independent::issue_12_independent_i06_encoder_offset; README, Tests"]
+#[ignore = "slow set (a survey draw: `encoder_offset` k=0 at SURVEY_SEED=1, 51 s): the default suite names offsets on a_named_offsets_interval_counts_each_runs_zeroing_error and independent::issue_12_independent_i06_encoder_offset; README, Tests"]
 fn an_offset_the_base_fit_mistakes_for_sticking_is_named_on_the_second_look() {
     let off = 100_000;
     let e_idx = 8; // encoder_offset's place in the survey's order
@@ -580,6 +581,7 @@ fn assert_offset_within_2_mrad(s: &DiscoverSummary, truth: f64) {
 /// indexed past the rows and discover panicked. A corrected view now carries the columns over
 /// with its own contrasts, and the offset is named.
 #[test]
+#[ignore = "slow set (a survey draw: `encoder_offset` k=2 at SURVEY_SEED=3): the default suite names offsets on a_named_offsets_interval_counts_each_runs_zeroing_error and independent::issue_12_independent_i06_encoder_offset; README, Tests"]
 fn an_offset_that_changes_which_runs_have_windows_does_not_break_the_screen() {
     let off = 300_000;
     let (e_idx, k) = (8, 2); // encoder_offset's place in the survey's order, and the draw
@@ -1031,6 +1033,7 @@ fn a_lag_tied_with_a_refused_tilt_is_judged_and_named_at_the_screens_value() {
 /// [−6.1e-3, −2.8e-3]): reported as an `unexplained` departure beside the right answer. A
 /// candidate the screen passed over may be named, but its refusal is no new departure.
 #[test]
+#[ignore = "slow set (a survey draw: `accel_delay` k=0 of the same draws): the default suite names a lag on a_lag_the_validate_runs_e_theta_cannot_see_is_judged_on_their_equation_error and independent::issue_12_independent_i07_accel_delay, and checks a departure beside a named effect on a_departure_the_validate_runs_reject_is_not_reported_beside_a_named_dry_torque; README, Tests"]
 fn a_breakaway_the_screen_passed_over_is_no_departure_beside_a_named_lag() {
     let truth = 0.00928245381417283;
     let s = discover(

@@ -671,6 +671,7 @@ fn a_growing_dry_torque_is_not_credited_with_the_damping_its_refit_repairs() {
 /// shape held 5.9e-4 ± 4.3e-4 N·m; beside a constant dry torque its interval reaches below 0. A
 /// breakaway the equation error cannot tell from the effect it generalises is not named on it.
 #[test]
+#[ignore = "slow set (the departure survey's draw 4 at DEPARTURE_SEED=4): the default suite checks a friction that differs from run to run on a_friction_that_differs_on_the_validate_runs_is_not_named_a_generator, and a breakaway refused where it generalises a constant dry torque on a_constant_dry_torque_is_not_named_as_a_breakaway_it_equals; README, Tests"]
 fn a_run_to_run_friction_is_not_named_a_breakaway_that_is_a_constant_dry_torque() {
     named_nothing("mu_run_spread", 4, 400_000);
 }
@@ -694,7 +695,7 @@ fn a_cable_anchored_off_the_vertical_is_not_named_an_encoder_offset() {
 /// disagreeing beyond twice the bar explains the departure only in part: nothing named, and the
 /// words say the torque follows the run.
 #[test]
-#[ignore = "slow set (the departure survey's draw 0 at DEPARTURE_SEED=3): the default suite checks a friction that differs from run to run on a_friction_that_differs_on_the_validate_runs_is_not_named_a_generator (nothing named, the words say the torque follows the run) and a_run_to_run_friction_is_not_named_a_breakaway_that_is_a_constant_dry_torque; README, Tests"]
+#[ignore = "slow set (the departure survey's draw 0 at DEPARTURE_SEED=3): the default suite checks a friction that differs from run to run on a_friction_that_differs_on_the_validate_runs_is_not_named_a_generator (nothing named, the words say the torque follows the run); README, Tests"]
 fn a_friction_that_differs_from_run_to_run_is_not_named_a_constant_dry_torque() {
     let words = named_nothing_and_said("mu_run_spread", 0, 300_000);
     assert!(words.contains("follows the run"), "{words}");
