@@ -707,7 +707,7 @@ fn a_lag_and_a_tilt_that_each_spoil_the_others_held_out_views_are_named_as_a_pai
 /// A large encoder offset's linearised remainder (θ_off²/2 · sin θ) looks like extra inertia: the
 /// offset must be applied exactly before the inertia is judged (it was −12 % off before).
 #[test]
-#[ignore = "slow set (the every-effect survey's third pair, one draw): the default suite names pairs on independent::issue_12_independent_i10_pair (the lag-and-tilt test is a known failure since 6b704f1), and an offset on independent::issue_12_independent_i06_encoder_offset; README, Tests"]
+#[ignore = "known failure (found in the twenty-eighth session; the slow set last passed on 09cdbb7's tests): only extra_inertia is named (1.147e-2 kg·m², refit 1.221e-2). Every run's free decay swings about +0.059 to +0.073 rad, but beside the inertia the screen holds the offset at 4.2e-2 rad with an interval of [−7.0, 7.0] (ΔBIC +4.9): three of the five identify runs rest and two are chaotic, and the screen's rows cannot size the offset beside the inertia and the runs' zeroing contrasts (which column it is degenerate with was not traced). The same diagnosis on 83b80f0's and b0def80's test binaries, so not this session's change. The default suite names offsets on a_named_offsets_interval_counts_each_runs_zeroing_error and independent::issue_12_independent_i06_encoder_offset, pairs on independent::issue_12_independent_i10_pair"]
 fn regression_issue_5_finds_offset_and_inertia_together() {
     assert_pair_found(3002, 7002, "encoder_offset", "extra_inertia");
 }
