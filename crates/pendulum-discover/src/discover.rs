@@ -2244,6 +2244,18 @@ pub fn discover(
         })
         .collect();
     let base_pinned = !base_pins.is_empty();
+    // The pins the pinned look judges against, and the spec whose ranges define them: the base
+    // fit's, or those of the model in hand when the first accepted effect leaves it pinned (see
+    // `after_pin`).
+    let mut look_pins = base_pins;
+    let mut look_spec = base_fit.spec.clone();
+    // The pinned look after the first accepted effect: set (to the re-screened round's
+    // candidates, the accepted effect left out) when the base fit was not pinned but the model
+    // holding that effect is. A hidden 0.067 rad encoder offset beside a hidden 1.13e-2 kg·m²
+    // inertia on a drawn design (three of five identify runs at rest) was screened at ΔBIC +4.9
+    // with an interval of ±7 rad; the inertia was named, its refit put μ at 0.25 (its bound), and
+    // the offset, named on the pinned look when hidden alone, was never judged again.
+    let mut after_pin: Option<Vec<Screened>> = None;
     let mut second = SecondLook::NotStarted;
     // The pair look (see [`PairLook`]): set while its first candidate is held provisionally.
     let mut pair: Option<PairLook> = None;
@@ -2258,9 +2270,10 @@ pub fn discover(
             // shape, cos θ, plus sin θ) whose refit disagreed, and a negative breakaway, and
             // stopped there with `unexplained`; its pinned look names the offset.
             None => match second.next(
-                round == 0 && (refused.is_none() || base_pinned),
-                base_pinned,
-                first_round,
+                (round == 0 && (refused.is_none() || base_pinned))
+                    || (round == 1 && after_pin.is_some()),
+                base_pinned || after_pin.is_some(),
+                after_pin.as_deref().unwrap_or(first_round),
             ) {
                 Some(sc) => sc,
                 None => break,
@@ -2774,12 +2787,12 @@ pub fn discover(
         // parameter off the end of the search range that held it? (It may leave another at an
         // end: on a heavily damped design whose runs mostly rest, a refit freeing b and μ traded
         // b for the quadratic drag a, at its bound, while the offset it held was right to 0.3 %.)
-        let unpins = !base_pins.is_empty()
-            && base_pins.iter().all(|&(p, side)| {
+        let unpins = !look_pins.is_empty()
+            && look_pins.iter().all(|&(p, side)| {
                 spec.params
                     .iter()
                     .position(|&q| q == p)
-                    .is_none_or(|i| base_fit.spec.at_end(p, x[i]) != Some(side))
+                    .is_none_or(|i| look_spec.at_end(p, x[i]) != Some(side))
             });
         // A breakaway's screen on the second look ran at the shape its own profile chose, which
         // is blind where the shape acts (see [`shape_start`]); at the shape the trajectories
@@ -3096,6 +3109,8 @@ pub fn discover(
                 },
                 if second_look && base_pinned {
                     "second look (the base model's fit was pinned at its search range; judged on the held-out runs and on whether the candidate's refit frees it)"
+                } else if second_look && after_pin.is_some() {
+                    "second look (the model holding the first named effect was pinned at its search range; judged on the held-out runs and on whether the candidate's refit frees it)"
                 } else if second_look {
                     "second look (the identify runs' equation error cannot see it; judged on the held-out runs)"
                 } else if excludes_zero {
@@ -3356,6 +3371,39 @@ pub fn discover(
                 // one, so the report named nothing while its model held the k = 4 torque.
                 let over = sw.passed_over(cfg.screen_threshold);
                 passed = over.iter().map(|s| s.candidate.effect.clone()).collect();
+                // The model holding the first accepted effect pinned where the base was not (see
+                // `after_pin`): its pins, and the re-screened candidates, for the pinned look.
+                if round == 1 && !base_pinned && matches!(second, SecondLook::NotStarted) {
+                    let pins: Vec<_> = current
+                        .spec
+                        .params
+                        .iter()
+                        .zip(&current.params)
+                        .filter_map(|(&p, &v)| match current.spec.at_end(p, v)? {
+                            pendulum_process::fit::Side::Lower
+                                if current.spec.range(p).0 == 0.0 =>
+                            {
+                                None
+                            }
+                            side => Some((p, side)),
+                        })
+                        .collect();
+                    if !pins.is_empty() {
+                        look_pins = pins;
+                        look_spec = current.spec.clone();
+                        after_pin = Some(
+                            sw.first_round
+                                .iter()
+                                .filter(|sc| {
+                                    !confirmed
+                                        .iter()
+                                        .any(|(e, r)| r.accepted && *e == sc.candidate.effect)
+                                })
+                                .cloned()
+                                .collect(),
+                        );
+                    }
+                }
                 queue = sw
                     .chosen
                     .iter()
