@@ -473,6 +473,19 @@ fn practically_significant(
         .is_none_or(|t| !(estimate.abs() <= t.bound(stamp_jitter_s, bob_inertia_kg_m2)))
 }
 
+/// The parameters of a fit (`params`, one per `spec.params`) held at an end of their search
+/// range, and which end. A lower end at 0 is a term the fit does not use, not a pin.
+fn pins(spec: &ModelSpec, params: &[f64]) -> Vec<(FitParam, pendulum_process::fit::Side)> {
+    spec.params
+        .iter()
+        .zip(params)
+        .filter_map(|(&p, &v)| match spec.at_end(p, v)? {
+            pendulum_process::fit::Side::Lower if spec.range(p).0 == 0.0 => None,
+            side => Some((p, side)),
+        })
+        .collect()
+}
+
 /// The smallest m l² over the campaign's runs with a known bob, kg·m² (NaN if none).
 fn lightest_bob_inertia_kg_m2(ctx: &Context) -> f64 {
     ctx.runs
@@ -2232,17 +2245,7 @@ pub fn discover(
     let mut round = 0;
     // The second look at the dry frictions (see [`SecondLook`]), at every candidate when the base
     // fit is pinned at its search range (see [`PINNED_LOOK`]).
-    let base_pins: Vec<(FitParam, pendulum_process::fit::Side)> = base_fit
-        .spec
-        .params
-        .iter()
-        .zip(&base_fit.params)
-        .filter_map(|(&p, &v)| match base_fit.spec.at_end(p, v)? {
-            // A term the fit does not use.
-            pendulum_process::fit::Side::Lower if base_fit.spec.range(p).0 == 0.0 => None,
-            side => Some((p, side)),
-        })
-        .collect();
+    let base_pins = pins(&base_fit.spec, &base_fit.params);
     let base_pinned = !base_pins.is_empty();
     // The pins the pinned look judges against, and the spec whose ranges define them: the base
     // fit's, or those of the model in hand when the first accepted effect leaves it pinned (see
@@ -3374,22 +3377,9 @@ pub fn discover(
                 // The model holding the first accepted effect pinned where the base was not (see
                 // `after_pin`): its pins, and the re-screened candidates, for the pinned look.
                 if round == 1 && !base_pinned && matches!(second, SecondLook::NotStarted) {
-                    let pins: Vec<_> = current
-                        .spec
-                        .params
-                        .iter()
-                        .zip(&current.params)
-                        .filter_map(|(&p, &v)| match current.spec.at_end(p, v)? {
-                            pendulum_process::fit::Side::Lower
-                                if current.spec.range(p).0 == 0.0 =>
-                            {
-                                None
-                            }
-                            side => Some((p, side)),
-                        })
-                        .collect();
-                    if !pins.is_empty() {
-                        look_pins = pins;
+                    let now_pinned = pins(&current.spec, &current.params);
+                    if !now_pinned.is_empty() {
+                        look_pins = now_pinned;
                         look_spec = current.spec.clone();
                         after_pin = Some(
                             sw.first_round
