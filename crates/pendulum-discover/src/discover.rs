@@ -3492,6 +3492,12 @@ pub fn discover(
         if !seen.insert(c.effect.clone()) {
             continue;
         }
+        // Judged in a later round (re-screened beside an accepted effect, or on the pinned look
+        // after it) though the first could not estimate it: its judgement is its row.
+        if let Some((_, row)) = confirmed.iter().find(|(e, _)| *e == c.effect) {
+            rows.push(row.clone());
+            continue;
+        }
         let unit = pendulum_model::effects::by_name(&c.effect)
             .and_then(|e| e.params().first().map(|p| p.unit))
             .unwrap_or("1");
