@@ -3376,33 +3376,24 @@ pub fn discover(
                 passed = over.iter().map(|s| s.candidate.effect.clone()).collect();
                 // The model holding the first accepted effect pinned where the base was not (see
                 // `after_pin`): its pins, and the re-screened candidates, for the pinned look.
+                let not_held = |sc: &&Screened| {
+                    !confirmed
+                        .iter()
+                        .any(|(e, r)| r.accepted && *e == sc.candidate.effect)
+                };
                 if round == 1 && !base_pinned && matches!(second, SecondLook::NotStarted) {
                     let now_pinned = pins(&current.spec, &current.params);
                     if !now_pinned.is_empty() {
                         look_pins = now_pinned;
                         look_spec = current.spec.clone();
-                        after_pin = Some(
-                            sw.first_round
-                                .iter()
-                                .filter(|sc| {
-                                    !confirmed
-                                        .iter()
-                                        .any(|(e, r)| r.accepted && *e == sc.candidate.effect)
-                                })
-                                .cloned()
-                                .collect(),
-                        );
+                        after_pin = Some(sw.first_round.iter().filter(not_held).cloned().collect());
                     }
                 }
                 queue = sw
                     .chosen
                     .iter()
                     .chain(&over)
-                    .filter(|sc| {
-                        !confirmed
-                            .iter()
-                            .any(|(e, r)| r.accepted && *e == sc.candidate.effect)
-                    })
+                    .filter(not_held)
                     .cloned()
                     .collect();
                 next = queue.pop_front();
