@@ -377,6 +377,40 @@ fn a_bouncing_bob_is_unexplained_and_follows_the_rate() {
     }
 }
 
+/// A bouncing bob whose screen route named an extra inertia and a position torque (the
+/// departure survey's `bob_bounce` k = 3 at `DEPARTURE_SEED=1`, k = 2 at `DEPARTURE_SEED=5`):
+/// the validate runs' own rows put each size far from the identify runs' (the inertia
+/// 1.80e-2 kg·m² against 3.75e-3; the torque 0.631 N·m against 0.212), so one size does not
+/// describe the departure and nothing may be named; the refused row's note gives both values.
+#[test]
+#[ignore = "slow set (two kept draws, 50 s on 2 cores): the default suite checks a bouncing bob on a_bouncing_bob_is_unexplained_and_follows_the_rate and the rule on the unit test sizes_disagree_only_apart_beyond_both_intervals_and_the_promised_accuracy; README, A partial explanation is not a cause"]
+fn a_bouncing_bob_whose_validate_runs_size_it_elsewhere_is_not_named() {
+    for (k, off) in [(3, 100_000), (2, 500_000)] {
+        let (seed, b, mu, departure) = drawn_departure("bob_bounce", k, off);
+        let s = discover_with(seed, b, mu, &departure);
+        let d = &s.discovery;
+        assert!(
+            d.accepted().is_empty(),
+            "draw {k} (+{off}): named {:?} for a bouncing bob ({departure})",
+            d.accepted()
+        );
+        assert!(
+            d.unexplained.is_some(),
+            "draw {k} (+{off}): nothing said for a bouncing bob"
+        );
+        assert!(
+            d.rows.iter().any(|r| r
+                .note
+                .contains("validate runs' own rows put its size elsewhere")),
+            "draw {k} (+{off}): no candidate refused for its held-out size: {:#?}",
+            d.rows
+                .iter()
+                .map(|r| (&r.effect, &r.note))
+                .collect::<Vec<_>>()
+        );
+    }
+}
+
 /// An encoder decoded at twice its counts (8192 a turn under a 4096 header, the quadrature
 /// mistake): every angle is doubled, far outside what a small correction describes. Nothing may
 /// be named and `unexplained` must speak. Measured: on two kept CLI designs of the growth test
