@@ -2925,6 +2925,23 @@ pub fn discover(
         // tilt beside a 6.25 ms lag was screened at −7.40e-2 on the identify runs and −8.79e-2
         // on the validate runs with the lag left out, and the lag at 6.25 ms and 8.24 ms with
         // the tilt left out, so neither was named.
+        // The equation-error view's value of the candidate's size on the rows of `rows`, with
+        // `cols` ([`pooled_screen_estimate`]).
+        let screen_on = |cols: &[usize], rows: FitOn| {
+            pooled_screen_estimate(
+                ctx,
+                &weak_ctx.alignments,
+                base,
+                &cfg.weak,
+                &correction,
+                &view,
+                cols,
+                c,
+                effect.kind(),
+                est,
+                rows,
+            )
+        };
         let heldout_size = if accepted && !second_look && c.shaped().is_none() {
             let mut beside_cols = cols.clone();
             for other in first_round.iter().filter(|o| {
@@ -2939,20 +2956,7 @@ pub fn discover(
                 }
             }
             let on = |rows: FitOn| {
-                pooled_screen_estimate(
-                    ctx,
-                    &weak_ctx.alignments,
-                    base,
-                    &cfg.weak,
-                    &correction,
-                    &view,
-                    &beside_cols,
-                    c,
-                    effect.kind(),
-                    est,
-                    rows,
-                )
-                .filter(|(v, s)| v.is_finite() && s.is_finite())
+                screen_on(&beside_cols, rows).filter(|(v, s)| v.is_finite() && s.is_finite())
             };
             on(FitOn::Identify).zip(on(FitOn::Validate))
         } else {
@@ -3147,19 +3151,7 @@ pub fn discover(
                 .map(|x| (x[i], f64::NAN))
             })
         } else {
-            pooled_screen_estimate(
-                ctx,
-                &weak_ctx.alignments,
-                base,
-                &cfg.weak,
-                &correction,
-                &view,
-                &cols,
-                c,
-                effect.kind(),
-                est,
-                FitOn::Every,
-            )
+            screen_on(&cols, FitOn::Every)
         }
         .filter(|(v, _)| v.is_finite() && physically_possible(&c.effect, *v));
         let (value, (ci_low, ci_high)) = match pooled {
