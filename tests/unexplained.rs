@@ -412,6 +412,33 @@ fn a_bouncing_bob_whose_validate_runs_size_it_elsewhere_is_not_named() {
     }
 }
 
+/// A bouncing bob named an accelerometer lag (the departure survey's `bob_bounce` k = 1 at
+/// `DEPARTURE_SEED=1`): a 64 ms "lag" took 31 % off the resting validate runs' equation error
+/// while their E_θ went 0.237 → 2.654 (+1020 % ± 139 %). Their E_θ does not respond to the lag
+/// itself, so the rise is the other terms' trade with it on the identify runs; a trade that
+/// makes the extended model ten times worse on the runs the fit never saw is not excused, and
+/// nothing may be named. The refused row says why.
+#[test]
+#[ignore = "slow set (one kept draw, 50 s on 2 cores): the default suite checks a bouncing bob on a_bouncing_bob_is_unexplained_and_follows_the_rate and the excused trade on a_lag_the_validate_runs_e_theta_cannot_see_is_judged_on_their_equation_error; README, A partial explanation is not a cause"]
+fn a_bouncing_bob_whose_lag_makes_the_held_out_runs_worse_is_not_named() {
+    let (seed, b, mu, departure) = drawn_departure("bob_bounce", 1, 100_000);
+    let s = discover_with(seed, b, mu, &departure);
+    let d = &s.discovery;
+    assert!(
+        d.accepted().is_empty(),
+        "named {:?} for a bouncing bob ({departure})",
+        d.accepted()
+    );
+    assert!(d.unexplained.is_some(), "nothing said for a bouncing bob");
+    let lag = d.row("accel_delay").expect("the lag was screened");
+    assert!(
+        lag.note
+            .contains("the other terms' trade with it makes the extended model worse"),
+        "{}",
+        lag.note
+    );
+}
+
 /// An encoder decoded at twice its counts (8192 a turn under a 4096 header, the quadrature
 /// mistake): every angle is doubled, far outside what a small correction describes. Nothing may
 /// be named and `unexplained` must speak. Measured: on two kept CLI designs of the growth test
