@@ -439,6 +439,32 @@ fn a_bouncing_bob_whose_lag_makes_the_held_out_runs_worse_is_not_named() {
     );
 }
 
+/// A dry torque growing with time (the departure survey's `dry_torque_growth` k = 0 at
+/// `DEPARTURE_SEED=5`; 3.6e-4 N·m/s, on a design whose one moving identify run carries it) was
+/// named a 0.25 ms accelerometer lag: screen and refit agreed (2.49e-4, 2.35e-4 s), the resting
+/// validate runs' equation error fell 28.7 % against 24.1 % needed, and their E_θ, which does
+/// not respond to the lag itself, moved −164 % ± 230 %. The equation error was the one view that
+/// judged it, and one view's bare pass is not two views agreeing: nothing may be named, and the
+/// lag's row says why.
+#[test]
+#[ignore = "slow set (one kept draw, 25 s on 2 cores): the default suite checks the lone view's margin on a_lag_the_validate_runs_e_theta_cannot_see_is_judged_on_their_equation_error (a true lag through it) and a growing friction on regression_issue_12_growing_dry_torque_is_unexplained; README, An input effect the validate runs' E_θ cannot see"]
+fn a_growing_friction_is_not_named_a_lag_on_one_views_bare_pass() {
+    let (seed, b, mu, departure) = drawn_departure("dry_torque_growth", 0, 500_000);
+    let s = discover_with(seed, b, mu, &departure);
+    let d = &s.discovery;
+    assert!(
+        d.accepted().is_empty(),
+        "named {:?} for a growing friction ({departure})",
+        d.accepted()
+    );
+    let lag = d.row("accel_delay").expect("the lag was screened");
+    assert!(
+        lag.note.contains("their equation error judges it alone"),
+        "{}",
+        lag.note
+    );
+}
+
 /// An encoder decoded at twice its counts (8192 a turn under a 4096 header, the quadrature
 /// mistake): every angle is doubled, far outside what a small correction describes. Nothing may
 /// be named and `unexplained` must speak. Measured: on two kept CLI designs of the growth test
