@@ -3270,19 +3270,21 @@ pub fn discover(
                 "; the trajectories cannot tell its size (the refit's set to 0 does no worse, the screen's fits them as well): the model judged on the held-out runs carries the screen's value, the other terms refitted",
             );
         }
+        // Each reason a blind view gives is said (a bouncing bob's lag fails both).
+        if blind && !blind_excused {
+            row.note.push_str(&format!(
+                "; the validate runs' E_θ does not respond to the effect itself, but the other terms' trade with it makes the extended model worse there by more than {SECOND_LOOK_GAIN_FACTOR} times the noise: not accepted"
+            ));
+        } else if blind_excused && !lone_short {
+            row.note.push_str(
+                "; the validate runs' E_θ does not respond to the effect itself (its size set to 0 in the refitted model scores within the noise): their E_θ cannot see it, and its rise is the other terms' trade",
+            );
+        }
         if lone_short {
             row.note.push_str(&format!(
                 "; the validate runs' E_θ does not respond to the effect itself (its size set to 0 in the refitted model scores within the noise): their equation error judges it alone, and its fall of {:.1} % does not clear its bar {SECOND_LOOK_GAIN_FACTOR} times over ({:.1} %): not accepted",
                 100.0 * eq_gain,
                 100.0 * fall_by_factor(eq_needed, SECOND_LOOK_GAIN_FACTOR)
-            ));
-        } else if blind_excused {
-            row.note.push_str(
-                "; the validate runs' E_θ does not respond to the effect itself (its size set to 0 in the refitted model scores within the noise): their E_θ cannot see it, and its rise is the other terms' trade",
-            );
-        } else if blind {
-            row.note.push_str(&format!(
-                "; the validate runs' E_θ does not respond to the effect itself, but the other terms' trade with it makes the extended model worse there by more than {SECOND_LOOK_GAIN_FACTOR} times the noise: not accepted"
             ));
         }
         // (Only where it did not confirm it anyway: a view may clear its bar beyond its reach.)
