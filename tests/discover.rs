@@ -704,6 +704,33 @@ fn a_lag_and_a_tilt_that_each_spoil_the_others_held_out_views_are_named_as_a_pai
     );
 }
 
+/// The every-effect survey's fresh draws (`SURVEY_SEED=9`), pair 3: a 0.031 rad tilted base
+/// beside a 7.3e-3 N·m constant dry torque. The tilt, screened first (ΔBIC −227, 3.18e-2 rad
+/// [2.90, 3.47]), took 70 % ± 19 % off the validate runs' E_θ and 98.8 % off their equation
+/// error, but its own trajectory refit said 2.81e-2 (11.7 % off its screen), the missing dry
+/// torque's work left to μ and the tilt, so it was refused as the views disagreeing, and the dry
+/// torque after it was not confirmed either: nothing named (on 4b9f406). The pair look holds
+/// such a first candidate too; beside the dry torque its refit agrees with its screen.
+#[test]
+#[ignore = "slow set (a survey draw: pair 3 at SURVEY_SEED=9): the default suite names pairs on independent::issue_12_independent_i10_pair; README, Tests"]
+fn a_tilt_whose_refit_a_missing_dry_torque_pulls_is_named_as_a_pair_beside_it() {
+    let s = assert_pair_found(903_003, 907_003, "coulomb_constant", "horizontal_base");
+    let row = s.discovery.row("horizontal_base").unwrap();
+    assert!(
+        row.note.contains("spoiled its trajectory refit")
+            && row.note.contains("which agrees with the screen"),
+        "{}",
+        row.note
+    );
+    // The refit in the model holding both is the one reported, and agrees within 10 %.
+    assert!(
+        (row.refit_estimate / row.screen_estimate - 1.0).abs() <= 0.10,
+        "refit {} vs screen {}",
+        row.refit_estimate,
+        row.screen_estimate
+    );
+}
+
 /// A large encoder offset's linearised remainder (θ_off²/2 · sin θ) looks like extra inertia: the
 /// offset must be applied exactly before the inertia is judged (it was −12 % off before).
 /// The every-effect survey's third pair at `SURVEY_SEED=0`: three of the five identify runs rest
