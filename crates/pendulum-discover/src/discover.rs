@@ -2842,11 +2842,12 @@ pub fn discover(
                 },
             )
         };
-        let plausible = partial.is_none()
+        // Everything but the agreement of the views (the pair look asks for that apart).
+        let plausible_but_agree = partial.is_none()
             && !runs_disagree
             && practically_significant(&c.effect, est, jitter_s, bob_inertia)
-            && possible
-            && agree;
+            && possible;
+        let plausible = plausible_but_agree && agree;
         // With the base pinned (see [`PINNED_LOOK`]): does the candidate's refit take each base
         // parameter off the end of the search range that held it? (It may leave another at an
         // end: on a heavily damped design whose runs mostly rest, a refit freeing b and μ traded
@@ -3058,13 +3059,7 @@ pub fn discover(
         // `SURVEY_SEED=9`) was screened at 3.18e-2 rad [2.90, 3.47] (truth 3.14e-2) and took
         // 70 % ± 19 % off the validate runs' E_θ and 98.8 % off their equation error, but its
         // refit, with the dry torque's work left to μ and the tilt, said 2.81e-2.
-        let pulled = !agree
-            && !refit_pinned
-            && held_out
-            && partial.is_none()
-            && !runs_disagree
-            && practically_significant(&c.effect, est, jitter_s, bob_inertia)
-            && possible;
+        let pulled = plausible_but_agree && !agree && !refit_pinned && held_out;
         let pair_start = if !accepted
             && !second_look
             && !pair_tried
