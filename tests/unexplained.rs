@@ -522,6 +522,15 @@ fn departures_outside_their_range_are_refused_by_key() {
             "torsion_spring_nm_per_rad = 0.1\ncable_anchor_rad = 4.0",
             "cable_anchor_rad",
         ),
+        ("encoder_eccentricity_rad = -0.01", "encoder_eccentricity_rad"),
+        (
+            "encoder_eccentricity_rad = 0.01\nencoder_eccentricity_phase_rad = 9.0",
+            "encoder_eccentricity_phase_rad",
+        ),
+        (
+            "encoder_eccentricity_phase_rad = 1.0",
+            "encoder_eccentricity_phase_rad",
+        ),
     ] {
         let toml = pendulum_jobs::demo::discovery_campaign(
             "departure",
@@ -547,7 +556,7 @@ type DrawDeparture = fn(&mut rand_chacha::ChaCha8Rng) -> String;
 /// The survey's departures, each with how its size is drawn: wider than the regression tests
 /// above (springs from barely felt to stiff, encoders mislabelled on either side of their
 /// header, plays, growths and run spreads from small to large).
-const DEPARTURES: [(&str, DrawDeparture); 8] = [
+const DEPARTURES: [(&str, DrawDeparture); 9] = [
     ("torsion_spring", |r| {
         let k = (r.random_range(0.02f64.ln()..0.3f64.ln())).exp();
         format!("torsion_spring_nm_per_rad = {k}")
@@ -584,6 +593,13 @@ const DEPARTURES: [(&str, DrawDeparture); 8] = [
         let hz = (r.random_range(3f64.ln()..12f64.ln())).exp();
         let zeta = r.random_range(0.02..0.2);
         format!("bob_bounce_hz = {hz}\nbob_bounce_damping_ratio = {zeta}")
+    }),
+    ("encoder_eccentricity", |r| {
+        // A code disc off its shaft's centre: e/R from a fine mount (0.003 rad, 2 counts) to a
+        // sloppy one (0.02 rad), its peak anywhere on the turn.
+        let phi = r.random_range(-std::f64::consts::PI..std::f64::consts::PI);
+        let eps = (r.random_range(0.003f64.ln()..0.02f64.ln())).exp();
+        format!("encoder_eccentricity_phase_rad = {phi}\nencoder_eccentricity_rad = {eps}")
     }),
 ];
 

@@ -118,6 +118,17 @@ pub struct Departures {
     /// The bouncing mount's damping ratio (default 0.05; with `bob_bounce_hz`).
     #[serde(default)]
     pub bob_bounce_damping_ratio: Option<f64>,
+    /// A code disc mounted off its shaft's centre (an eccentricity e on a code track of radius
+    /// R reads the angle with an error (e/R)·sin(θ − φ), once per revolution): this e/R, rad.
+    /// The count is zeroed with the pendulum hanging, so the measured angle is
+    /// θ + ε·(sin(θ − φ) + sin φ): a scale error of ε cos φ about the hanging position, a
+    /// once-per-turn error on rotating runs.
+    #[serde(default)]
+    pub encoder_eccentricity_rad: Option<f64>,
+    /// Where the eccentricity's error peaks, φ, rad (default 0; with
+    /// `encoder_eccentricity_rad`).
+    #[serde(default)]
+    pub encoder_eccentricity_phase_rad: Option<f64>,
 }
 
 impl Departures {
@@ -178,6 +189,27 @@ impl Departures {
             return Some((
                 "bob_bounce_damping_ratio",
                 "a damping ratio beside a bob_bounce_hz (alone it has no mount to damp)",
+            ));
+        }
+        if bad(self.encoder_eccentricity_rad, |v| (0.0..0.5).contains(&v)) {
+            return Some((
+                "encoder_eccentricity_rad",
+                "a finite eccentricity e/R in [0, 0.5) rad",
+            ));
+        }
+        if bad(self.encoder_eccentricity_phase_rad, |v| {
+            v.abs() <= 2.0 * std::f64::consts::PI
+        }) {
+            return Some((
+                "encoder_eccentricity_phase_rad",
+                "a finite phase within ±2π rad",
+            ));
+        }
+        if self.encoder_eccentricity_phase_rad.is_some() && self.encoder_eccentricity_rad.is_none()
+        {
+            return Some((
+                "encoder_eccentricity_phase_rad",
+                "a phase beside an encoder_eccentricity_rad (alone it has no disc to misplace)",
             ));
         }
         if bad(self.dry_torque_growth_nm_per_s, |v| v >= 0.0) {
@@ -868,6 +900,17 @@ fn synthesize_run(
     let cpr_true = case.truth.departures.encoder_cpr_true.unwrap_or(4096.0);
     if let Some(play) = case.truth.departures.encoder_backlash_rad {
         backlash(&mut theta, play);
+    }
+    if let Some(eps) = case.truth.departures.encoder_eccentricity_rad {
+        let phi = case
+            .truth
+            .departures
+            .encoder_eccentricity_phase_rad
+            .unwrap_or(0.0);
+        // Zeroed hanging: the error at θ = 0, ε sin(−φ), is counted away at power-on.
+        for th in &mut theta {
+            *th += eps * ((*th - phi).sin() + phi.sin());
+        }
     }
     let counts: Vec<i64> = theta
         .iter()
