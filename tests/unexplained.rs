@@ -523,6 +523,12 @@ fn departures_outside_their_range_are_refused_by_key() {
             "cable_anchor_rad",
         ),
         ("encoder_eccentricity_rad = -0.01", "encoder_eccentricity_rad"),
+        ("dry_torque_lobes_nm = -0.01", "dry_torque_lobes_nm"),
+        (
+            "dry_torque_lobes_nm = 0.01\ndry_torque_lobes_k = 0",
+            "dry_torque_lobes_k",
+        ),
+        ("dry_torque_lobes_k = 2", "dry_torque_lobes_k"),
         (
             "encoder_eccentricity_rad = 0.01\nencoder_eccentricity_phase_rad = 9.0",
             "encoder_eccentricity_phase_rad",
@@ -556,7 +562,7 @@ type DrawDeparture = fn(&mut rand_chacha::ChaCha8Rng) -> String;
 /// The survey's departures, each with how its size is drawn: wider than the regression tests
 /// above (springs from barely felt to stiff, encoders mislabelled on either side of their
 /// header, plays, growths and run spreads from small to large).
-const DEPARTURES: [(&str, DrawDeparture); 9] = [
+const DEPARTURES: [(&str, DrawDeparture); 10] = [
     ("torsion_spring", |r| {
         let k = (r.random_range(0.02f64.ln()..0.3f64.ln())).exp();
         format!("torsion_spring_nm_per_rad = {k}")
@@ -600,6 +606,16 @@ const DEPARTURES: [(&str, DrawDeparture); 9] = [
         let phi = r.random_range(-std::f64::consts::PI..std::f64::consts::PI);
         let eps = (r.random_range(0.003f64.ln()..0.02f64.ln())).exp();
         format!("encoder_eccentricity_phase_rad = {phi}\nencoder_eccentricity_rad = {eps}")
+    }),
+    ("dry_torque_lobes", |r| {
+        // A bent shaft (1 lobe) or an oval seal (2, 3) dragging 0 to 2T around the turn, T from
+        // a seal's 3e-3 N·m to 1.5e-2 N·m.
+        let k = r.random_range(1..=3u32);
+        let phi = r.random_range(-std::f64::consts::PI..std::f64::consts::PI);
+        let t = (r.random_range(3e-3f64.ln()..1.5e-2f64.ln())).exp();
+        format!(
+            "dry_torque_lobes_k = {k}\ndry_torque_lobes_phase_rad = {phi}\ndry_torque_lobes_nm = {t}"
+        )
     }),
 ];
 

@@ -238,6 +238,16 @@ pub struct Dimensionless {
     /// Absent = 0.
     #[serde(default)]
     pub c_rate: f64,
+    /// A dry torque that varies around the turn, c_lobes·(1 + cos(k θ − φ)) sgn θ̇ with k =
+    /// `c_lobes_k` and φ = `c_lobes_phase` (a bent shaft or an oval seal dragging more over
+    /// part of each turn; ≥ 0 everywhere, held in full at rest): a departure outside the
+    /// catalogue for tests of an honest `unexplained`. Absent = 0.
+    #[serde(default)]
+    pub c_lobes: f64,
+    #[serde(default)]
+    pub c_lobes_k: u32,
+    #[serde(default)]
+    pub c_lobes_phase: f64,
 }
 
 impl Default for Dimensionless {
@@ -267,6 +277,15 @@ impl Dimensionless {
         x - x.clamp(-self.kappa_slack, self.kappa_slack)
     }
 
+    /// The lobed dry torque's size at θ, c_lobes·(1 + cos(k θ − φ)) (0 without one).
+    #[inline]
+    pub fn lobed_dry(&self, theta: f64) -> f64 {
+        if self.c_lobes == 0.0 {
+            return 0.0;
+        }
+        self.c_lobes * (1.0 + (f64::from(self.c_lobes_k) * theta - self.c_lobes_phase).cos())
+    }
+
     /// A free pendulum with no damping and no base motion.
     pub fn conservative() -> Self {
         Self {
@@ -292,6 +311,9 @@ impl Dimensionless {
             kappa_slack: 0.0,
             kappa_anchor: 0.0,
             c_rate: 0.0,
+            c_lobes: 0.0,
+            c_lobes_k: 1,
+            c_lobes_phase: 0.0,
         }
     }
 
@@ -364,8 +386,25 @@ impl Dimensionless {
                 false,
                 Some((self.c_rate >= 0.0, NON_NEG)),
             ),
+            slot(
+                "c_lobes",
+                "c_lobes",
+                self.c_lobes,
+                false,
+                Some((self.c_lobes >= 0.0, NON_NEG)),
+            ),
             slot("p", "p", self.p, false, None),
         ];
+        if self.c_lobes != 0.0 {
+            out.push(slot(
+                "c_lobes_k",
+                "k_c",
+                f64::from(self.c_lobes_k),
+                true,
+                None,
+            ));
+            out.push(slot("c_lobes_phase", "φ_c", self.c_lobes_phase, true, None));
+        }
         if self.p != 0.0 {
             out.push(slot("k", "k", f64::from(self.k), true, None));
             out.push(slot("phi_p", "φ_p", self.phi_p, true, None));

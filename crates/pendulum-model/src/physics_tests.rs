@@ -175,6 +175,77 @@ fn constant_coulomb_decay_follows_work_energy_law() {
     assert!(th.sin().abs() <= c + 1e-12, "rest at {th}");
 }
 
+/// A dry torque that varies around the turn, c·(1 + cos(k θ − φ)) (a departure the twin hides:
+/// a bent shaft, an oval seal). It depends on θ alone, so its work over a half swing from rest at
+/// x0 to rest at x1 is c·|x1 − x0 + (sin(k x1 − φ) − sin(k x0 − φ))/k| in closed form, and
+/// cos x0 − cos x1 equals it: each turning point is exact. The pendulum sticks where
+/// |sin x| ≤ c·(1 + cos(k x − φ)), the torque it holds at that angle.
+#[test]
+fn lobed_dry_torque_decay_follows_work_energy_law() {
+    let (c, k, phi) = (0.006, 2u32, 0.7);
+    let mut d = Dimensionless::conservative();
+    d.c_lobes = c;
+    d.c_lobes_k = k;
+    d.c_lobes_phase = phi;
+    let m = Model::with_excitation(d, Excitation::None);
+    let kf = f64::from(k);
+    let work = |x0: f64, x1: f64| c * (x1 - x0 + ((kf * x1 - phi).sin() - (kf * x0 - phi).sin()) / kf).abs();
+    let holds = |x: f64| x.sin().abs() <= c * (1.0 + (kf * x - phi).cos());
+    let a0: f64 = 0.9;
+    let mut expected = vec![-a0];
+    loop {
+        let x0 = *expected.last().unwrap();
+        if holds(x0) {
+            break;
+        }
+        // Energy: cos x1 = cos x0 + work(x0, x1) (the potential is −cos θ). g(x1) = cos x0 −
+        // cos x1 + work rises from x0 (g = 0 there, then < 0 while gravity outpaces friction)
+        // to > 0 at the mirror −x0; the rest point is its root past x0, bisected on [0, −x0]
+        // when the pendulum passes the bottom, else on [x0, 0].
+        let g = |x1: f64| x0.cos() - x1.cos() + work(x0, x1);
+        let (mut lo, mut hi) = if g(0.0) < 0.0 { (0.0, -x0) } else { (x0 * (1.0 - 1e-12), 0.0) };
+        for _ in 0..200 {
+            let mid = 0.5 * (lo + hi);
+            if (g(mid) < 0.0) == (g(lo) < 0.0) {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        let x1 = 0.5 * (lo + hi);
+        expected.push(x1);
+    }
+    assert!(expected.len() > 10, "{expected:?}");
+
+    let tr = simulate(
+        &m,
+        &SimOptions::with_tol(1e-11),
+        [-a0, 0.0],
+        0.0,
+        600.0,
+        0.002,
+    )
+    .unwrap();
+    assert!(tr.stats.ended_stuck);
+    assert_eq!(*tr.theta_dot.last().unwrap(), 0.0);
+    let mut got = vec![a0];
+    got.extend(turning_points(&tr.theta, &tr.theta_dot));
+    got.push(tr.theta.last().unwrap().abs());
+    got.dedup_by(|x, y| (*x - *y).abs() < 1e-9);
+    let expected: Vec<f64> = expected.iter().map(|x| x.abs()).collect();
+    assert_eq!(got.len(), expected.len(), "{got:?} vs {expected:?}");
+    for (g, e) in got.iter().zip(&expected) {
+        assert!((g - e).abs() < 2e-7, "turning point {g} vs work–energy {e}");
+    }
+    // The lobes matter: the decrements per half swing vary with where the swing turns (a
+    // constant dry torque's are all ≈ 2c on small swings).
+    let dec: Vec<f64> = expected.windows(2).map(|w| w[0] - w[1]).collect();
+    let (lo, hi) = dec[..dec.len() - 1]
+        .iter()
+        .fold((f64::MAX, 0.0f64), |(l, h), &d| (l.min(d), h.max(d)));
+    assert!(hi > 1.05 * lo, "decrements {lo}..{hi}");
+}
+
 /// Bearing friction M|θ̇² + cos θ|: at small amplitude the loss per half swing is ≈ 2M, constant
 /// (linear decay) — unlike viscous damping, whose decrement shrinks with the amplitude.
 #[test]

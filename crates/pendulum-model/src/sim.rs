@@ -91,7 +91,7 @@ impl Model {
 
     fn has_dry_friction(&self) -> bool {
         let p = &self.params;
-        p.m_coulomb > 0.0 || p.c > 0.0 || p.s_break > 0.0 || p.c_rate > 0.0
+        p.m_coulomb > 0.0 || p.c > 0.0 || p.s_break > 0.0 || p.c_rate > 0.0 || p.c_lobes > 0.0
     }
 
     /// Non-friction torque at rest, Q, and the static friction capacity C, at (t, θ).
@@ -111,7 +111,10 @@ impl Model {
             c.abs()
         };
         // At rest the fading dry torque holds with its full size s.
-        (q, p.m_coulomb * load + p.c + p.c_rate * t + p.s_break)
+        (
+            q,
+            p.m_coulomb * load + p.c + p.c_rate * t + p.s_break + p.lobed_dry(theta),
+        )
     }
 
     /// The generator's mode at θ̇: ±1 on (beyond the dead band on that side), 0 off (inside it).
@@ -167,6 +170,9 @@ impl Model {
                 (w2 + c).abs()
             };
             let mut dry = p.m_coulomb * load + p.c + p.c_rate * t;
+            if p.c_lobes != 0.0 {
+                dry += p.lobed_dry(theta);
+            }
             // Tested, not multiplied by zero: the exp is the costliest term, and most models lack it.
             if STRIBECK && p.s_break != 0.0 {
                 let x = theta_dot / p.v_break;
@@ -223,7 +229,7 @@ impl Model {
             base: -ay * s - ax * c,
             viscous: -p.beta * theta_dot,
             quadratic: -p.alpha * theta_dot * theta_dot.abs(),
-            dry: -(p.m_coulomb * load + p.c + p.c_rate * t + fading) * dir,
+            dry: -(p.m_coulomb * load + p.c + p.c_rate * t + p.lobed_dry(theta) + fading) * dir,
             generator: -p.gen_c * excess * dir,
             position: -p.p * (p.k as f64 * theta + p.phi_p).sin(),
             spring: -p.kappa * p.spring_stretch(theta),

@@ -123,7 +123,7 @@ fn coarse_step(model: &Model, m: Mount) -> f64 {
 /// (slope ≈ D/V_EPS for the largest dry torque D).
 fn step(model: &Model, m: Mount, t_end: f64) -> f64 {
     let p = &model.params;
-    let dry_max = p.m_coulomb * 3.0 + p.c + p.s_break + p.c_rate * t_end.max(0.0);
+    let dry_max = p.m_coulomb * 3.0 + p.c + p.s_break + p.c_rate * t_end.max(0.0) + 2.0 * p.c_lobes;
     let h = coarse_step(model, m);
     if dry_max > 0.0 {
         h.min(1.5 * V_EPS / dry_max)

@@ -129,6 +129,17 @@ pub struct Departures {
     /// `encoder_eccentricity_rad`).
     #[serde(default)]
     pub encoder_eccentricity_phase_rad: Option<f64>,
+    /// A dry torque that varies around the turn (a bent shaft or an oval seal dragging more
+    /// over part of each turn), N·m: T·(1 + cos(k θ − φ)) sgn θ', from 0 to 2T, held in full at
+    /// rest.
+    #[serde(default)]
+    pub dry_torque_lobes_nm: Option<f64>,
+    /// Its lobes per turn, k (default 1; with `dry_torque_lobes_nm`).
+    #[serde(default)]
+    pub dry_torque_lobes_k: Option<u32>,
+    /// Where it drags most, φ, rad (default 0; with `dry_torque_lobes_nm`).
+    #[serde(default)]
+    pub dry_torque_lobes_phase_rad: Option<f64>,
 }
 
 impl Departures {
@@ -210,6 +221,32 @@ impl Departures {
             return Some((
                 "encoder_eccentricity_phase_rad",
                 "a phase beside an encoder_eccentricity_rad (alone it has no disc to misplace)",
+            ));
+        }
+        if bad(self.dry_torque_lobes_nm, |v| v >= 0.0) {
+            return Some((
+                "dry_torque_lobes_nm",
+                "a finite size ≥ 0 N·m (a dry torque below 0 would feed energy in)",
+            ));
+        }
+        if self.dry_torque_lobes_k.is_some_and(|k| k == 0) {
+            return Some(("dry_torque_lobes_k", "a lobe count ≥ 1"));
+        }
+        if bad(self.dry_torque_lobes_phase_rad, |v| {
+            v.abs() <= 2.0 * std::f64::consts::PI
+        }) {
+            return Some(("dry_torque_lobes_phase_rad", "a finite phase within ±2π rad"));
+        }
+        if (self.dry_torque_lobes_k.is_some() || self.dry_torque_lobes_phase_rad.is_some())
+            && self.dry_torque_lobes_nm.is_none()
+        {
+            return Some((
+                if self.dry_torque_lobes_k.is_some() {
+                    "dry_torque_lobes_k"
+                } else {
+                    "dry_torque_lobes_phase_rad"
+                },
+                "a lobe count or phase beside a dry_torque_lobes_nm (alone it has no torque to shape)",
             ));
         }
         if bad(self.dry_torque_growth_nm_per_s, |v| v >= 0.0) {
@@ -674,6 +711,11 @@ fn synthesize_run(
     if let Some(rate) = case.truth.departures.dry_torque_growth_nm_per_s {
         // Per dimensionless time (t̃ = ω0 t).
         d.c_rate = rate / (phys.m_kg * phys.g_m_s2 * phys.l_m) / phys.omega0_rad_s();
+    }
+    if let Some(t) = case.truth.departures.dry_torque_lobes_nm {
+        d.c_lobes = t / (phys.m_kg * phys.g_m_s2 * phys.l_m);
+        d.c_lobes_k = case.truth.departures.dry_torque_lobes_k.unwrap_or(1);
+        d.c_lobes_phase = case.truth.departures.dry_torque_lobes_phase_rad.unwrap_or(0.0);
     }
     let w0 = phys.omega0_rad_s();
     // Dimensionless time of the shaker start and of being at speed.
