@@ -522,7 +522,10 @@ fn departures_outside_their_range_are_refused_by_key() {
             "torsion_spring_nm_per_rad = 0.1\ncable_anchor_rad = 4.0",
             "cable_anchor_rad",
         ),
-        ("encoder_eccentricity_rad = -0.01", "encoder_eccentricity_rad"),
+        (
+            "encoder_eccentricity_rad = -0.01",
+            "encoder_eccentricity_rad",
+        ),
         ("dry_torque_lobes_nm = -0.01", "dry_torque_lobes_nm"),
         (
             "dry_torque_lobes_nm = 0.01\ndry_torque_lobes_k = 0",

@@ -36,7 +36,7 @@ pub struct Term {
 }
 
 /// The library, in the order of [`library_values`].
-pub const LIBRARY: [Term; 23] = [
+pub const LIBRARY: [Term; 31] = [
     t(
         "θ̇",
         Variable::Rate,
@@ -152,6 +152,66 @@ pub const LIBRARY: [Term; 23] = [
         "(rad/s)²",
         1,
     ),
+    // A dry friction whose size varies around the turn (a bent shaft, a seal that drags more
+    // over part of each turn): sgn θ̇ times one harmonic of θ, entering with sgn θ̇ itself
+    // ([`MAIN_EFFECT`]). A constant dry torque fitted to one was named where it drags from 0 to
+    // twice its mean (a departure the twin hides as `dry_torque_lobes`).
+    tl(
+        "sgn θ̇ sin θ",
+        Variable::AngleInTurn,
+        "a dry friction that varies around the turn with 1 lobe (a bent shaft, an oval seal)",
+        "1",
+        1,
+    ),
+    tl(
+        "sgn θ̇ cos θ",
+        Variable::AngleInTurn,
+        "a dry friction that varies around the turn with 1 lobe (a bent shaft, an oval seal)",
+        "1",
+        1,
+    ),
+    tl(
+        "sgn θ̇ sin 2θ",
+        Variable::AngleInTurn,
+        "a dry friction that varies around the turn with 2 lobes (a bent shaft, an oval seal)",
+        "1",
+        2,
+    ),
+    tl(
+        "sgn θ̇ cos 2θ",
+        Variable::AngleInTurn,
+        "a dry friction that varies around the turn with 2 lobes (a bent shaft, an oval seal)",
+        "1",
+        2,
+    ),
+    tl(
+        "sgn θ̇ sin 3θ",
+        Variable::AngleInTurn,
+        "a dry friction that varies around the turn with 3 lobes (a bent shaft, an oval seal)",
+        "1",
+        3,
+    ),
+    tl(
+        "sgn θ̇ cos 3θ",
+        Variable::AngleInTurn,
+        "a dry friction that varies around the turn with 3 lobes (a bent shaft, an oval seal)",
+        "1",
+        3,
+    ),
+    tl(
+        "sgn θ̇ sin 4θ",
+        Variable::AngleInTurn,
+        "a dry friction that varies around the turn with 4 lobes (a bent shaft, an oval seal)",
+        "1",
+        4,
+    ),
+    tl(
+        "sgn θ̇ cos 4θ",
+        Variable::AngleInTurn,
+        "a dry friction that varies around the turn with 4 lobes (a bent shaft, an oval seal)",
+        "1",
+        4,
+    ),
 ];
 
 /// Library terms that are, alone, a catalogue effect's own torque shape (the effect's regressor
@@ -180,7 +240,21 @@ pub const CONFIRMED_ONLY: [&str; 1] = ["θ̇² (1 + A_y) sin θ"];
 ///
 /// Likewise the gravity torque growing with θ̇² enters with sin θ: its size at rest is the model's
 /// own gravity, whose error (a bob a little heavier or longer than declared) is sin θ alone.
-const MAIN_EFFECT: [(&str, &str); 2] = [("t sgn θ̇", "sgn θ̇"), ("θ̇² (1 + A_y) sin θ", "sin θ")];
+///
+/// And a dry friction varying around the turn is sgn θ̇ times a harmonic of θ *and* sgn θ̇: its
+/// size, 0 to twice its mean, never changes sign.
+const MAIN_EFFECT: [(&str, &str); 10] = [
+    ("t sgn θ̇", "sgn θ̇"),
+    ("θ̇² (1 + A_y) sin θ", "sin θ"),
+    ("sgn θ̇ sin θ", "sgn θ̇"),
+    ("sgn θ̇ cos θ", "sgn θ̇"),
+    ("sgn θ̇ sin 2θ", "sgn θ̇"),
+    ("sgn θ̇ cos 2θ", "sgn θ̇"),
+    ("sgn θ̇ sin 3θ", "sgn θ̇"),
+    ("sgn θ̇ cos 3θ", "sgn θ̇"),
+    ("sgn θ̇ sin 4θ", "sgn θ̇"),
+    ("sgn θ̇ cos 4θ", "sgn θ̇"),
+];
 
 /// The library index of term `j`'s main effect, if it has one.
 fn main_effect(j: usize) -> Option<usize> {
@@ -267,6 +341,14 @@ pub fn library_values(
         t_s,
         t_s * sg,
         theta_dot * theta_dot * (1.0 + a_y) * theta.sin(),
+        sg * theta.sin(),
+        sg * theta.cos(),
+        sg * (2.0 * theta).sin(),
+        sg * (2.0 * theta).cos(),
+        sg * (3.0 * theta).sin(),
+        sg * (3.0 * theta).cos(),
+        sg * (4.0 * theta).sin(),
+        sg * (4.0 * theta).cos(),
     ]
 }
 
@@ -977,6 +1059,30 @@ mod tests {
         assert!(cmp.partial(), "{cmp:?}");
         assert!(
             cmp.terms.iter().any(|&j| LIBRARY[j].name == "t sgn θ̇"),
+            "{cmp:?}"
+        );
+        let constant = comparison_rows(1.9, x, |_, thd, _| 4e-3 * thd.signum());
+        let cmp = family_beats_candidate(&constant, &[], &[], &[0], &family).unwrap();
+        assert!(!cmp.partial(), "{cmp:?}");
+    }
+
+    /// A dry friction whose size varies around the turn, from 0 to twice its mean (a bent shaft:
+    /// 1 + cos(2θ − 1.2)), is a freer shape of the constant dry torque's own (sgn θ̇ times a
+    /// harmonic of θ beside sgn θ̇): the constant torque explains it only in part. One that does
+    /// not vary is not refused for the new terms.
+    #[test]
+    fn a_dry_friction_that_varies_around_the_turn_makes_a_constant_torque_partial() {
+        let x = |_: f64, thd: f64, _: f64| vec![thd.signum()];
+        let family = [Variable::Rate];
+        let lobed = comparison_rows(1.9, x, |th, thd, _| {
+            4e-3 * (1.0 + (2.0 * th - 1.2).cos()) * thd.signum()
+        });
+        let cmp = family_beats_candidate(&lobed, &[], &[], &[0], &family).unwrap();
+        assert!(cmp.partial(), "{cmp:?}");
+        assert!(
+            cmp.terms
+                .iter()
+                .any(|&j| LIBRARY[j].name.starts_with("sgn θ̇ ") && LIBRARY[j].lobes == 2),
             "{cmp:?}"
         );
         let constant = comparison_rows(1.9, x, |_, thd, _| 4e-3 * thd.signum());

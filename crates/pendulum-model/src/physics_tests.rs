@@ -189,7 +189,9 @@ fn lobed_dry_torque_decay_follows_work_energy_law() {
     d.c_lobes_phase = phi;
     let m = Model::with_excitation(d, Excitation::None);
     let kf = f64::from(k);
-    let work = |x0: f64, x1: f64| c * (x1 - x0 + ((kf * x1 - phi).sin() - (kf * x0 - phi).sin()) / kf).abs();
+    let work = |x0: f64, x1: f64| {
+        c * (x1 - x0 + ((kf * x1 - phi).sin() - (kf * x0 - phi).sin()) / kf).abs()
+    };
     let holds = |x: f64| x.sin().abs() <= c * (1.0 + (kf * x - phi).cos());
     let a0: f64 = 0.9;
     let mut expected = vec![-a0];
@@ -203,7 +205,11 @@ fn lobed_dry_torque_decay_follows_work_energy_law() {
         // to > 0 at the mirror −x0; the rest point is its root past x0, bisected on [0, −x0]
         // when the pendulum passes the bottom, else on [x0, 0].
         let g = |x1: f64| x0.cos() - x1.cos() + work(x0, x1);
-        let (mut lo, mut hi) = if g(0.0) < 0.0 { (0.0, -x0) } else { (x0 * (1.0 - 1e-12), 0.0) };
+        let (mut lo, mut hi) = if g(0.0) < 0.0 {
+            (0.0, -x0)
+        } else {
+            (x0 * (1.0 - 1e-12), 0.0)
+        };
         for _ in 0..200 {
             let mid = 0.5 * (lo + hi);
             if (g(mid) < 0.0) == (g(lo) < 0.0) {

@@ -235,7 +235,10 @@ impl Departures {
         if bad(self.dry_torque_lobes_phase_rad, |v| {
             v.abs() <= 2.0 * std::f64::consts::PI
         }) {
-            return Some(("dry_torque_lobes_phase_rad", "a finite phase within ±2π rad"));
+            return Some((
+                "dry_torque_lobes_phase_rad",
+                "a finite phase within ±2π rad",
+            ));
         }
         if (self.dry_torque_lobes_k.is_some() || self.dry_torque_lobes_phase_rad.is_some())
             && self.dry_torque_lobes_nm.is_none()
@@ -715,7 +718,11 @@ fn synthesize_run(
     if let Some(t) = case.truth.departures.dry_torque_lobes_nm {
         d.c_lobes = t / (phys.m_kg * phys.g_m_s2 * phys.l_m);
         d.c_lobes_k = case.truth.departures.dry_torque_lobes_k.unwrap_or(1);
-        d.c_lobes_phase = case.truth.departures.dry_torque_lobes_phase_rad.unwrap_or(0.0);
+        d.c_lobes_phase = case
+            .truth
+            .departures
+            .dry_torque_lobes_phase_rad
+            .unwrap_or(0.0);
     }
     let w0 = phys.omega0_rad_s();
     // Dimensionless time of the shaker start and of being at speed.
