@@ -155,59 +155,62 @@ pub const LIBRARY: [Term; 31] = [
     // A dry friction whose size varies around the turn (a bent shaft, a seal that drags more
     // over part of each turn): sgn θ̇ times one harmonic of θ, entering with sgn θ̇ itself
     // ([`MAIN_EFFECT`]). A constant dry torque fitted to one was named where it drags from 0 to
-    // twice its mean (a departure the twin hides as `dry_torque_lobes`).
+    // twice its mean (a departure the twin hides as `dry_torque_lobes`). A friction, so it
+    // follows θ̇ (its sign is θ̇'s): in the family of the effects that follow θ̇, not of those
+    // that follow θ. As θ's, another simulator's k = 2 position torque beside an extra inertia
+    // (`i10_pair`) was refused as a partial explanation of sgn θ̇ sin 2θ and cos 2θ.
     tl(
         "sgn θ̇ sin θ",
-        Variable::AngleInTurn,
+        Variable::Rate,
         "a dry friction that varies around the turn with 1 lobe (a bent shaft, an oval seal)",
         "1",
         1,
     ),
     tl(
         "sgn θ̇ cos θ",
-        Variable::AngleInTurn,
+        Variable::Rate,
         "a dry friction that varies around the turn with 1 lobe (a bent shaft, an oval seal)",
         "1",
         1,
     ),
     tl(
         "sgn θ̇ sin 2θ",
-        Variable::AngleInTurn,
+        Variable::Rate,
         "a dry friction that varies around the turn with 2 lobes (a bent shaft, an oval seal)",
         "1",
         2,
     ),
     tl(
         "sgn θ̇ cos 2θ",
-        Variable::AngleInTurn,
+        Variable::Rate,
         "a dry friction that varies around the turn with 2 lobes (a bent shaft, an oval seal)",
         "1",
         2,
     ),
     tl(
         "sgn θ̇ sin 3θ",
-        Variable::AngleInTurn,
+        Variable::Rate,
         "a dry friction that varies around the turn with 3 lobes (a bent shaft, an oval seal)",
         "1",
         3,
     ),
     tl(
         "sgn θ̇ cos 3θ",
-        Variable::AngleInTurn,
+        Variable::Rate,
         "a dry friction that varies around the turn with 3 lobes (a bent shaft, an oval seal)",
         "1",
         3,
     ),
     tl(
         "sgn θ̇ sin 4θ",
-        Variable::AngleInTurn,
+        Variable::Rate,
         "a dry friction that varies around the turn with 4 lobes (a bent shaft, an oval seal)",
         "1",
         4,
     ),
     tl(
         "sgn θ̇ cos 4θ",
-        Variable::AngleInTurn,
+        Variable::Rate,
         "a dry friction that varies around the turn with 4 lobes (a bent shaft, an oval seal)",
         "1",
         4,
