@@ -175,6 +175,31 @@ fn constant_coulomb_decay_follows_work_energy_law() {
     assert!(th.sin().abs() <= c + 1e-12, "rest at {th}");
 }
 
+/// A free decay of `m` from rest at −`a0` (to t = 600, tolerance 1e-11) turns at, and finally
+/// sticks at, the amplitudes `expected` (a0 first), each within 2e-7 rad: the final rest point is
+/// reached stuck (θ̇ = 0 exactly), not as a turning point.
+fn assert_rests_match(m: &Model, a0: f64, expected: &[f64]) {
+    let tr = simulate(
+        m,
+        &SimOptions::with_tol(1e-11),
+        [-a0, 0.0],
+        0.0,
+        600.0,
+        0.002,
+    )
+    .unwrap();
+    assert!(tr.stats.ended_stuck);
+    assert_eq!(*tr.theta_dot.last().unwrap(), 0.0);
+    let mut got = vec![a0];
+    got.extend(turning_points(&tr.theta, &tr.theta_dot));
+    got.push(tr.theta.last().unwrap().abs());
+    got.dedup_by(|x, y| (*x - *y).abs() < 1e-9);
+    assert_eq!(got.len(), expected.len(), "{got:?} vs {expected:?}");
+    for (g, e) in got.iter().zip(expected) {
+        assert!((g - e).abs() < 2e-7, "turning point {g} vs work–energy {e}");
+    }
+}
+
 /// A dry torque that varies around the turn, c·(1 + cos(k θ − φ)) (a departure the twin hides:
 /// a bent shaft, an oval seal). It depends on θ alone, so its work over a half swing from rest at
 /// x0 to rest at x1 is c·|x1 − x0 + (sin(k x1 − φ) − sin(k x0 − φ))/k| in closed form, and
@@ -223,26 +248,8 @@ fn lobed_dry_torque_decay_follows_work_energy_law() {
     }
     assert!(expected.len() > 10, "{expected:?}");
 
-    let tr = simulate(
-        &m,
-        &SimOptions::with_tol(1e-11),
-        [-a0, 0.0],
-        0.0,
-        600.0,
-        0.002,
-    )
-    .unwrap();
-    assert!(tr.stats.ended_stuck);
-    assert_eq!(*tr.theta_dot.last().unwrap(), 0.0);
-    let mut got = vec![a0];
-    got.extend(turning_points(&tr.theta, &tr.theta_dot));
-    got.push(tr.theta.last().unwrap().abs());
-    got.dedup_by(|x, y| (*x - *y).abs() < 1e-9);
     let expected: Vec<f64> = expected.iter().map(|x| x.abs()).collect();
-    assert_eq!(got.len(), expected.len(), "{got:?} vs {expected:?}");
-    for (g, e) in got.iter().zip(&expected) {
-        assert!((g - e).abs() < 2e-7, "turning point {g} vs work–energy {e}");
-    }
+    assert_rests_match(&m, a0, &expected);
     // The lobes matter: the decrements per half swing vary with where the swing turns (a
     // constant dry torque's are all ≈ 2c on small swings).
     let dec: Vec<f64> = expected.windows(2).map(|w| w[0] - w[1]).collect();
@@ -518,27 +525,7 @@ fn breakaway_decay_follows_work_energy_law() {
     let last = *expected.last().unwrap();
     assert!(last.sin() > c, "last rest {last} would hold with c alone");
 
-    let tr = simulate(
-        &m,
-        &SimOptions::with_tol(1e-11),
-        [-a0, 0.0],
-        0.0,
-        600.0,
-        0.002,
-    )
-    .unwrap();
-    let mut got = vec![a0];
-    got.extend(turning_points(&tr.theta, &tr.theta_dot));
-    // The final rest point is reached stuck (θ̇ = 0 exactly), not as a turning point.
-    let rest = tr.theta.last().unwrap().abs();
-    assert!(tr.stats.ended_stuck);
-    assert_eq!(*tr.theta_dot.last().unwrap(), 0.0);
-    got.push(rest);
-    got.dedup_by(|x, y| (*x - *y).abs() < 1e-9);
-    assert_eq!(got.len(), expected.len(), "{got:?} vs {expected:?}");
-    for (g, e) in got.iter().zip(&expected) {
-        assert!((g - e).abs() < 2e-7, "turning point {g} vs work–energy {e}");
-    }
+    assert_rests_match(&m, a0, &expected);
 }
 
 /// Stick/slip under forcing with a breakaway torque: while stuck the static balance holds with
