@@ -169,10 +169,8 @@ impl Model {
             } else {
                 (w2 + c).abs()
             };
-            let mut dry = p.m_coulomb * load + p.c + p.c_rate * t;
-            if p.c_lobes != 0.0 {
-                dry += p.lobed_dry(theta);
-            }
+            // `lobed_dry` tests its own zero first: most models lack it.
+            let mut dry = p.m_coulomb * load + p.c + p.c_rate * t + p.lobed_dry(theta);
             // Tested, not multiplied by zero: the exp is the costliest term, and most models lack it.
             if STRIBECK && p.s_break != 0.0 {
                 let x = theta_dot / p.v_break;
