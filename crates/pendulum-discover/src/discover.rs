@@ -2845,8 +2845,9 @@ pub fn discover(
                 .collect();
             crate::sparse::run_spread(&view.weak, &res, &cols, &pooled, &every_run).is_some_and(
                 |sp| {
-                    sp.heldout_gain
-                        > SECOND_LOOK_GAIN_FACTOR * sp.heldout_noise.max(cfg.eq_gain_min)
+                    sp.material()
+                        && sp.heldout_gain
+                            > SECOND_LOOK_GAIN_FACTOR * sp.heldout_noise.max(cfg.eq_gain_min)
                 },
             )
         };
