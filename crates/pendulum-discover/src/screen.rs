@@ -166,7 +166,7 @@ impl Ols {
 
 /// 1/(1 + J/(m l²)) of the row's run: (1 + j)θ̈ = −G − D puts every dynamics term into the
 /// target divided by 1 + j (see [`crate::weak::is_dynamics`]).
-fn inertia_divisor(r: &WeakRow, inertia_kg_m2: f64) -> f64 {
+pub(crate) fn inertia_divisor(r: &WeakRow, inertia_kg_m2: f64) -> f64 {
     if inertia_kg_m2 == 0.0 {
         1.0
     } else {
@@ -175,7 +175,7 @@ fn inertia_divisor(r: &WeakRow, inertia_kg_m2: f64) -> f64 {
 }
 
 /// The value of column `c` in row `r` of the design, given the extra inertia J.
-fn design(r: &WeakRow, c: usize, inertia_kg_m2: f64) -> f64 {
+pub(crate) fn design(r: &WeakRow, c: usize, inertia_kg_m2: f64) -> f64 {
     if is_dynamics(c) {
         r.x[c] * inertia_divisor(r, inertia_kg_m2)
     } else {

@@ -857,14 +857,11 @@ pub fn family_beats_candidate(
     // judged beside a named 0.01 kg·m² inertia, both exactly as hidden, was refused as a partial
     // explanation (the description 56 % ± 17 % better on the validate rows, a share of 0.68)
     // on another simulator's campaign with its runs' roles rotated, and nearly so on our own.
-    let mass = crate::weak::mass_column();
+    let holds_mass = |cols: &[usize]| crate::weak::mass_column().filter(|m| cols.contains(m));
     let inertia_of = |cols: &[usize]| -> f64 {
-        match mass {
-            Some(m) if cols.contains(&m) => crate::screen::ols(id_rows, cols)
-                .and_then(|f| f.coef_of(m))
-                .map_or(0.0, |(j, _)| j),
-            _ => 0.0,
-        }
+        holds_mass(cols)
+            .and_then(|m| crate::screen::ols(id_rows, cols)?.coef_of(m))
+            .map_or(0.0, |(j, _)| j)
     };
     let all: Vec<usize> = current.iter().chain(&extra).copied().collect();
     let j_cand = inertia_of(&all);
@@ -872,20 +869,19 @@ pub fn family_beats_candidate(
     // The description holds the current columns and library terms: its inertia is the one the
     // candidate's fit gives it, where the current model holds one (the description is not
     // handicapped by the candidate's absence from its J).
-    let j_desc = if j_base != 0.0 { j_cand } else { 0.0 };
+    let j_desc = if holds_mass(current).is_some() {
+        j_cand
+    } else {
+        0.0
+    };
     let design_of = |rows: &[WeakRow], j: f64| -> Vec<Vec<f64>> {
         rows.iter()
             .map(|r| {
-                let f = if j != 0.0 && r.bob_inertia_kg_m2 > 0.0 {
-                    1.0 / (1.0 + j / r.bob_inertia_kg_m2)
-                } else {
-                    1.0
-                };
-                let dyn_f = |c: usize| if crate::weak::is_dynamics(c) { f } else { 1.0 };
+                let f = crate::screen::inertia_divisor(r, j);
                 current
                     .iter()
                     .chain(&extra)
-                    .map(|&c| r.x[c] * dyn_f(c))
+                    .map(|&c| crate::screen::design(r, c, j))
                     .chain(r.lib.iter().map(|v| v * f))
                     .collect()
             })
