@@ -2843,13 +2843,19 @@ pub fn discover(
                 .iter()
                 .map(|&col| fit.coef_of(col).map_or(0.0, |v| v.0))
                 .collect();
-            crate::sparse::run_spread(&view.weak, &res, &cols, &pooled, &every_run).is_some_and(
-                |sp| {
-                    sp.material()
-                        && sp.heldout_gain
-                            > SECOND_LOOK_GAIN_FACTOR * sp.heldout_noise.max(cfg.eq_gain_min)
-                },
+            crate::sparse::run_spread(
+                &view.weak,
+                &res,
+                &cols,
+                &pooled,
+                fit.inertia_kg_m2,
+                &every_run,
             )
+            .is_some_and(|sp| {
+                sp.material()
+                    && sp.heldout_gain
+                        > SECOND_LOOK_GAIN_FACTOR * sp.heldout_noise.max(cfg.eq_gain_min)
+            })
         };
         // Everything but the agreement of the views (the pair look asks for that apart).
         let plausible_but_agree = partial.is_none()
@@ -3708,11 +3714,6 @@ pub fn discover(
     // A generic sparse description of what remains, judged on the validate rows like a
     // catalogue effect; the catalogue model's own columns are refitted along with it.
     let description = {
-        let nuisance: Vec<Vec<f64>> = view
-            .weak
-            .iter()
-            .map(|r| current_cols.iter().map(|&c| r.x[c]).collect())
-            .collect();
         let lib: Vec<Vec<f64>> = view.weak.iter().map(|r| r.lib.clone()).collect();
         let centre: Vec<_> = view
             .weak
@@ -3729,7 +3730,14 @@ pub fn discover(
             .collect();
         let describe = |without: &[&str]| {
             crate::sparse::describe(
-                &view.weak, &final_res, &lib, &nuisance, &id_mask, &centre, without,
+                &view.weak,
+                &final_res,
+                &lib,
+                &current_cols,
+                final_ols.inertia_kg_m2,
+                &id_mask,
+                &centre,
+                without,
             )
         };
         match describe(&[]) {
@@ -3789,7 +3797,14 @@ pub fn discover(
             .iter()
             .map(|&c| final_ols.coef_of(c).map_or(0.0, |v| v.0))
             .collect();
-        crate::sparse::run_spread(&view.weak, &final_res, &current_cols, &pooled, &id_mask)
+        crate::sparse::run_spread(
+            &view.weak,
+            &final_res,
+            &current_cols,
+            &pooled,
+            final_ols.inertia_kg_m2,
+            &id_mask,
+        )
     };
     let structure = match (
         structure,

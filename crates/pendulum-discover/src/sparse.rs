@@ -475,24 +475,37 @@ fn wls(x: &[Vec<f64>], y: &[f64], w: &[f64], cols: &[usize]) -> Option<(Vec<f64>
 }
 
 /// Fits a sparse description of `residual` (one per row; the identify rows fit it, the validate
-/// rows judge it) on the rows' library columns `lib` (one vector per row). `nuisance`: further
-/// columns per row that are refitted along (the catalogue model's own terms, so that the
-/// description is of what the model cannot absorb). `None` when no term earns its place.
+/// rows judge it) on the rows' library columns `lib` (one vector per row). `nuisance`: the
+/// catalogue model's own columns, refitted along so that the description is of what the model
+/// cannot absorb. `inertia_kg_m2`: the model's extra inertia J, at which `residual` was left:
+/// every torque, the library's and the model's dynamics columns, reaches the target divided by
+/// each run's 1 + J/(m l²) ([`crate::screen::inertia_divisor`]), so it is described that way and
+/// its size reads in N·m (on the raw columns a described torque read 10–20 % small beside the
+/// independent campaigns' 0.01 kg·m², and each run's divisor was left for the terms to take up).
+/// `None` when no term earns its place.
 #[allow(clippy::too_many_arguments)]
 pub fn describe(
     rows: &[WeakRow],
     residual: &[f64],
     lib: &[Vec<f64>],
-    nuisance: &[Vec<f64>],
+    nuisance: &[usize],
+    inertia_kg_m2: f64,
     is_identify: &[bool],
     centre_values: &[[f64; LIBRARY.len()]],
     without: &[&str],
 ) -> Option<Description> {
-    let n_nuis = nuisance.first().map_or(0, |v| v.len());
+    let n_nuis = nuisance.len();
     let design: Vec<Vec<f64>> = lib
         .iter()
-        .zip(nuisance)
-        .map(|(l, q)| q.iter().chain(l.iter()).copied().collect())
+        .zip(rows)
+        .map(|(l, r)| {
+            let f = crate::screen::inertia_divisor(r, inertia_kg_m2);
+            nuisance
+                .iter()
+                .map(|&c| crate::screen::design(r, c, inertia_kg_m2))
+                .chain(l.iter().map(|v| v * f))
+                .collect()
+        })
         .collect();
     let pick = |want: bool| -> (Vec<Vec<f64>>, Vec<f64>, Vec<f64>, Vec<usize>) {
         let idx: Vec<usize> = (0..rows.len())
@@ -666,19 +679,24 @@ impl RunSpread {
 /// even [`RUN_BLOCK_S`] blocks and judged on its odd ones, each run's encoder zeroing refitted on
 /// both sides (a zeroing error of a few counts is the rig's own run-to-run difference, not a
 /// departure). One factor per run because a run keeps only a few dozen weak-form rows where it
-/// moves. `None` with fewer than two runs to compare.
+/// moves. `inertia_kg_m2`: the model's extra inertia J, at which `residual` was left; the loss
+/// torque reaches the target divided by each run's 1 + J/(m l²), as in the fit, so that a factor
+/// is the run's damping against the campaign's and not that times its divisor (on the raw
+/// columns a run's departure from 1 read 10–20 % small beside a 0.01 kg·m² inertia, against the
+/// [`RUN_SPREAD_MIN`] floor). `None` with fewer than two runs to compare.
 pub fn run_spread(
     rows: &[WeakRow],
     residual: &[f64],
     cols: &[usize],
     pooled: &[f64],
+    inertia_kg_m2: f64,
     is_identify: &[bool],
 ) -> Option<RunSpread> {
     let torque = |r: &WeakRow| -> f64 {
         cols.iter()
             .zip(pooled)
             .filter(|(c, _)| crate::weak::is_loss(**c))
-            .map(|(&c, v)| r.x[c] * v)
+            .map(|(&c, v)| crate::screen::design(r, c, inertia_kg_m2) * v)
             .sum()
     };
     let fitting = |r: &WeakRow| (r.tau_s / RUN_BLOCK_S).floor().rem_euclid(2.0) == 0.0;
@@ -1259,14 +1277,14 @@ mod tests {
             noise.push(e);
             is_id.push(run != 2 && run != 5);
         }
-        let nuis: Vec<Vec<f64>> = vec![Vec::new(); n];
-        let d = describe(&rows, &spring, &lib, &nuis, &is_id, &centre, &[]).expect("a description");
+        let d =
+            describe(&rows, &spring, &lib, &[], 0.0, &is_id, &centre, &[]).expect("a description");
         assert_eq!(d.variable, Variable::Angle, "{:?}", d.terms);
         let (j, k, se) = d.terms[0];
         assert_eq!(LIBRARY[j].name, "θ");
         assert!((k + 0.004).abs() < 3.0 * se.max(1e-6), "k = {k} ± {se}");
         assert!(d.heldout_gain > d.heldout_noise, "{d:?}");
-        assert!(describe(&rows, &noise, &lib, &nuis, &is_id, &centre, &[]).is_none());
+        assert!(describe(&rows, &noise, &lib, &[], 0.0, &is_id, &centre, &[]).is_none());
     }
 
     /// Runs whose viscous damping differs (×0.8, ×1.0, ×1.25 of the campaign's) leave residuals
@@ -1294,12 +1312,12 @@ mod tests {
             rows.push(r);
         }
         let is_id = vec![true; rows.len()];
-        let s = run_spread(&rows, &spread, &[lin], &[b], &is_id).expect("a spread");
+        let s = run_spread(&rows, &spread, &[lin], &[b], 0.0, &is_id).expect("a spread");
         assert!(s.confirmed(0.05), "{s:?}");
         for (run, f) in &s.factors {
             assert!((f - truth[*run]).abs() < 0.01, "run {run}: ×{f}");
         }
-        let s0 = run_spread(&rows, &shared, &[lin], &[b], &is_id).expect("a spread");
+        let s0 = run_spread(&rows, &shared, &[lin], &[b], 0.0, &is_id).expect("a spread");
         assert!(!s0.confirmed(0.05), "{s0:?}");
         // Runs that differ by 0.3 % at most, on a noise 100 times smaller: their factors predict
         // the held-out blocks, but no mechanic could act on such a difference.
@@ -1309,12 +1327,62 @@ mod tests {
             .zip(&shared)
             .map(|(r, e)| b * (slight[r.run] - 1.0) * r.x[lin] + 0.01 * e)
             .collect();
-        let s1 = run_spread(&rows, &tiny, &[lin], &[b], &is_id).expect("a spread");
+        let s1 = run_spread(&rows, &tiny, &[lin], &[b], 0.0, &is_id).expect("a spread");
         assert!(s1.heldout_gain > 0.05_f64.max(s1.heldout_noise), "{s1:?}");
         assert!(!s1.material() && !s1.confirmed(0.05), "{s1:?}");
         // Nothing to scale: no loss among the columns.
         let off = crate::weak::observation_column().expect("an offset column");
-        assert!(run_spread(&rows, &spread, &[off], &[1e-3], &is_id).is_none());
+        assert!(run_spread(&rows, &spread, &[off], &[1e-3], 0.0, &is_id).is_none());
+    }
+
+    /// Beside an extra inertia J, every torque reaches the target divided by its run's
+    /// 1 + J/(m l²): each run's damping factor and a described torque's size read at full size
+    /// when asked at J, and 10–20 % small on the raw columns (two bobs, J/(m l²) 0.1 and 0.2).
+    #[test]
+    fn beside_an_extra_inertia_run_factors_and_described_sizes_read_at_full_size() {
+        let lin = crate::weak::column_of("viscous_linear").expect("a viscous column");
+        let width = crate::weak::columns().len();
+        let (b, j, spring) = (0.5, 0.01, -0.004);
+        let truth = [0.8, 1.0, 1.25];
+        let (mut rows, mut spread, mut lib, mut centre, mut sprung) =
+            (vec![], vec![], vec![], vec![], vec![]);
+        for i in 0..900 {
+            let run = i % 3;
+            let mut r = row(run, 1.0);
+            r.tau_s = 0.1 * (i / 3) as f64;
+            r.bob_inertia_kg_m2 = if run == 1 { 0.05 } else { 0.10 };
+            r.x = vec![0.0; width];
+            r.x[lin] = 2.0 * (0.37 * i as f64).sin() + 0.5;
+            let f = crate::screen::inertia_divisor(&r, j);
+            assert!((f - 1.0 / (1.0 + j / r.bob_inertia_kg_m2)).abs() < 1e-15);
+            let e = 0.01 * (((i as f64 * 12.9898).sin() * 43_758.545).fract() - 0.5);
+            spread.push(b * (truth[run] - 1.0) * r.x[lin] * f + e);
+            let th = 2.0 * (0.3 * i as f64).sin() + 0.01 * i as f64;
+            let v = library_values(th, 3.0 * (0.7 * i as f64).cos(), f64::NAN, r.tau_s, 0.0);
+            sprung.push(spring * th * f + 0.1 * e);
+            lib.push(v.to_vec());
+            centre.push(v);
+            rows.push(r);
+        }
+        let is_id: Vec<bool> = (0..rows.len()).map(|i| i % 6 < 4).collect();
+        let every = vec![true; rows.len()];
+        let s = run_spread(&rows, &spread, &[lin], &[b], j, &every).expect("a spread");
+        for (run, f) in &s.factors {
+            assert!((f - truth[*run]).abs() < 0.01, "run {run}: ×{f}");
+        }
+        let raw = run_spread(&rows, &spread, &[lin], &[b], 0.0, &every).expect("a spread");
+        // On the raw columns each departure from 1 reads its run's divisor (1/1.1 here) times.
+        for (run, f) in raw.factors.iter().filter(|(r, _)| *r != 1) {
+            let expected = 1.0 + (truth[*run] - 1.0) / 1.1;
+            assert!((f - expected).abs() < 0.01, "raw run {run}: ×{f}");
+        }
+        let d = describe(&rows, &sprung, &lib, &[], j, &is_id, &centre, &[]).expect("described");
+        let (term, k, se) = d.terms[0];
+        assert_eq!(LIBRARY[term].name, "θ");
+        assert!((k - spring).abs() < 0.02 * spring.abs(), "k = {k} ± {se}");
+        let d0 = describe(&rows, &sprung, &lib, &[], 0.0, &is_id, &centre, &[]).expect("raw");
+        let k0 = d0.terms.iter().find(|t| t.0 == term).map_or(0.0, |t| t.1);
+        assert!((k0 - spring).abs() > 0.1 * spring.abs(), "raw k = {k0}");
     }
 
     /// Each twin names a library term and a catalogue effect that follows the term's variable.
