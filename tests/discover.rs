@@ -1297,16 +1297,20 @@ fn issue_15_finds_the_generator_when_hidden() {
 /// lines, base, a, b, μ), from the effect's catalogue entry (`Effect::survey`): the base model
 /// that lacks it, then its parameters drawn in the entry's order (the first is the truth).
 fn draw(effect: &str, r: &mut rand_chacha::ChaCha8Rng) -> (f64, String, Base, f64, f64, f64) {
-    draw_scaled(effect, r, 1.0)
+    draw_scaled(effect, r, 1.0, None)
 }
 
 /// [`draw`] with the effect's size (its first drawn parameter) times `size_scale`: the survey's
 /// `SURVEY_SIZE_SCALE` asks how discover fares on effects smaller than the catalogue's survey
-/// draws them (a held-out set may draw other sizes).
+/// draws them (a held-out set may draw other sizes). With `damping` (the survey's
+/// `SURVEY_DAMPING=drawn`), the rig's own damping is drawn from it too, over the ranges the
+/// false-alarm survey and the independent campaigns use (a 0–0.1 kg/m, b 0.3–0.7 N·s/m,
+/// μ 0.08–0.2; each base draws its own terms), before the effect's draws, which set theirs.
 fn draw_scaled(
     effect: &str,
     r: &mut rand_chacha::ChaCha8Rng,
     size_scale: f64,
+    damping: Option<&mut rand_chacha::ChaCha8Rng>,
 ) -> (f64, String, Base, f64, f64, f64) {
     use pendulum_model::effects::{by_name, Draw};
     let e = by_name(effect).unwrap_or_else(|| panic!("no catalogue effect {effect}"));
@@ -1318,6 +1322,21 @@ fn draw_scaled(
         "dry" => (Base::Dry, 0.0, 0.0, 0.15),
         "reference" => (Base::Reference, 0.0, 0.5, 0.15),
         other => panic!("{effect}: unknown survey base {other}"),
+    };
+    let (a, b, mu) = match damping {
+        None => (a, b, mu),
+        Some(d) => {
+            let (da, db, dmu) = (
+                d.random_range(0.0..0.1),
+                d.random_range(0.3..0.7),
+                d.random_range(0.08..0.2),
+            );
+            match base {
+                Base::Reference => (da, db, dmu),
+                Base::Linear => (a, db, mu),
+                Base::Dry => (a, b, dmu),
+            }
+        }
     };
     let mut p = pendulum_model::Physical {
         a_kg_m: a,
@@ -1370,7 +1389,7 @@ fn draw_scaled(
 /// each drifts as the identify runs' do. Named alone, within 1 %.
 #[test]
 fn small_speed_drift_is_confirmed_by_the_validate_runs_crank_tracks() {
-    let (truth, spec, base, a, b, mu) = draw_scaled("speed_drift", &mut rng(2100), 0.4);
+    let (truth, spec, base, a, b, mu) = draw_scaled("speed_drift", &mut rng(2100), 0.4, None);
     let s = discover(6100, base, a, b, mu, &spec);
     assert_eq!(
         s.discovery.accepted(),
@@ -1400,7 +1419,7 @@ fn small_speed_drift_is_confirmed_by_the_validate_runs_crank_tracks() {
 #[test]
 #[ignore = "slow set (a survey draw: `speed_drift` k=1 of the 0.4 × survey): the default suite names drifts on small_speed_drift_is_confirmed_by_the_validate_runs_crank_tracks and independent::issue_12_independent_i08_speed_drift; README, Tests"]
 fn resting_validate_runs_do_not_veto_a_drift_the_identify_runs_feel() {
-    let (truth, spec, base, a, b, mu) = draw_scaled("speed_drift", &mut rng(2101), 0.4);
+    let (truth, spec, base, a, b, mu) = draw_scaled("speed_drift", &mut rng(2101), 0.4, None);
     let s = discover(6101, base, a, b, mu, &spec);
     let row = s.discovery.row("speed_drift").expect("a speed_drift row");
     // The design this test is about: the validate runs' E_θ does not fall.
@@ -1458,7 +1477,7 @@ fn a_run_zeroed_off_by_counts_does_not_hide_a_cogging_torque() {
 /// as much as its size's: named within 10 % or not at all, and then saying why.
 #[test]
 fn a_breakaway_whose_refit_runs_its_speed_scale_to_the_range_end_is_not_named_there() {
-    let (truth, spec, base, a, b, mu) = draw_scaled("stribeck", &mut rng(602_203), 1.0);
+    let (truth, spec, base, a, b, mu) = draw_scaled("stribeck", &mut rng(602_203), 1.0, None);
     let s = discover(606_203, base, a, b, mu, &spec);
     let accepted = s.discovery.accepted();
     let row = s.discovery.row("stribeck").expect("a stribeck row");
@@ -1492,7 +1511,7 @@ fn a_breakaway_whose_refit_runs_its_speed_scale_to_the_range_end_is_not_named_th
 #[test]
 #[ignore = "slow set (a survey draw: `stribeck` k=0 at SURVEY_SEED=7): the default suite names breakaways on a_breakaway_is_judged_on_the_validate_runs_free_segments_too and a_named_breakaway_is_sized_on_every_runs_trajectories, and a lag the E_θ cannot see on a_lag_the_validate_runs_e_theta_cannot_see_is_judged_on_their_equation_error; README, Tests"]
 fn a_breakaway_the_validate_runs_equation_error_cannot_see_is_judged_on_their_trajectories() {
-    let (truth, spec, base, a, b, mu) = draw_scaled("stribeck", &mut rng(702_200), 1.0);
+    let (truth, spec, base, a, b, mu) = draw_scaled("stribeck", &mut rng(702_200), 1.0, None);
     let s = discover(706_200, base, a, b, mu, &spec);
     let accepted = s.discovery.accepted();
     let row = s.discovery.row("stribeck").expect("a stribeck row");
@@ -1517,7 +1536,7 @@ fn a_breakaway_the_validate_runs_equation_error_cannot_see_is_judged_on_their_tr
 #[test]
 #[ignore = "slow set (a survey draw: `stribeck` k=4 at SURVEY_SEED=7): the default suite names breakaways on a_breakaway_is_judged_on_the_validate_runs_free_segments_too and a_named_breakaway_is_sized_on_every_runs_trajectories, and refuses one whose views disagree on a_breakaway_whose_refit_runs_its_speed_scale_to_the_range_end_is_not_named_there; README, Tests"]
 fn a_breakaway_both_identify_views_size_alike_at_the_trajectories_shape_is_named() {
-    let (truth, spec, base, a, b, mu) = draw_scaled("stribeck", &mut rng(702_204), 1.0);
+    let (truth, spec, base, a, b, mu) = draw_scaled("stribeck", &mut rng(702_204), 1.0, None);
     let s = discover(706_204, base, a, b, mu, &spec);
     assert_found(&s, "stribeck", truth, 0.10, 0.0);
     let row = s.discovery.row("stribeck").unwrap();
@@ -1539,7 +1558,7 @@ fn a_breakaway_both_identify_views_size_alike_at_the_trajectories_shape_is_named
 #[test]
 #[ignore = "slow set (a survey draw: `stribeck` k=4 at SURVEY_SEED=8): the default suite names breakaways on a_breakaway_is_judged_on_the_validate_runs_free_segments_too and a_named_breakaway_is_sized_on_every_runs_trajectories, and holds each run's zeroing error on a_named_offsets_interval_counts_each_runs_zeroing_error; README, Tests"]
 fn a_breakaway_shape_is_chosen_again_once_each_runs_zeroing_error_is_held() {
-    let (truth, spec, base, a, b, mu) = draw_scaled("stribeck", &mut rng(802_204), 1.0);
+    let (truth, spec, base, a, b, mu) = draw_scaled("stribeck", &mut rng(802_204), 1.0, None);
     let s = discover(806_204, base, a, b, mu, &spec);
     assert_found(&s, "stribeck", truth, 0.10, 0.0);
 }
@@ -1554,7 +1573,7 @@ fn a_breakaway_shape_is_chosen_again_once_each_runs_zeroing_error_is_held() {
 /// widened to hold the refit) still holds 0, so this does not ask what `assert_found` asks of it.
 #[test]
 fn a_breakaway_is_judged_on_the_validate_runs_free_segments_too() {
-    let (truth, spec, base, a, b, mu) = draw_scaled("stribeck", &mut rng(702_201), 1.0);
+    let (truth, spec, base, a, b, mu) = draw_scaled("stribeck", &mut rng(702_201), 1.0, None);
     let s = discover(706_201, base, a, b, mu, &spec);
     assert_eq!(s.discovery.accepted(), vec!["stribeck"]);
     let row = s.discovery.row("stribeck").unwrap();
@@ -1574,7 +1593,7 @@ fn a_breakaway_is_judged_on_the_validate_runs_free_segments_too() {
 #[test]
 #[ignore = "slow set (a survey draw: `stribeck` k=0 of the every-effect survey at SURVEY_SEED=8 draws it again): the default suite checks that a breakaway is judged on the validate runs' free segments on a_breakaway_is_judged_on_the_validate_runs_free_segments_too, and sized on every run on a_named_breakaway_is_sized_on_every_runs_trajectories; README, Tests"]
 fn a_named_breakaway_is_refitted_on_the_validate_runs_free_segments_too() {
-    let (truth, spec, base, a, b, mu) = draw_scaled("stribeck", &mut rng(802_200), 1.0);
+    let (truth, spec, base, a, b, mu) = draw_scaled("stribeck", &mut rng(802_200), 1.0, None);
     let s = discover(806_200, base, a, b, mu, &spec);
     assert_found(&s, "stribeck", truth, 0.10, 0.0);
     let text = s.to_string();
@@ -1593,7 +1612,7 @@ fn a_named_breakaway_is_refitted_on_the_validate_runs_free_segments_too() {
 /// truth, the identify runs' own value kept beside it.
 #[test]
 fn a_lag_the_resting_identify_runs_size_loosely_is_sized_on_every_run_once_named() {
-    let (truth, spec, base, a, b, mu) = draw_scaled("accel_delay", &mut rng(701_902), 1.0);
+    let (truth, spec, base, a, b, mu) = draw_scaled("accel_delay", &mut rng(701_902), 1.0, None);
     let s = discover(705_902, base, a, b, mu, &spec);
     assert_found(&s, "accel_delay", truth, 0.10, 0.0);
     let row = s.discovery.row("accel_delay").unwrap();
@@ -1618,7 +1637,7 @@ fn a_lag_the_resting_identify_runs_size_loosely_is_sized_on_every_run_once_named
 /// interval named counts the runs' zeroing scatter, and holds the truth.
 #[test]
 fn a_named_offsets_interval_counts_each_runs_zeroing_error() {
-    let (truth, spec, base, a, b, mu) = draw_scaled("encoder_offset", &mut rng(701_802), 1.0);
+    let (truth, spec, base, a, b, mu) = draw_scaled("encoder_offset", &mut rng(701_802), 1.0, None);
     let s = discover(705_802, base, a, b, mu, &spec);
     assert_found(&s, "encoder_offset", truth, 0.10, 0.0);
     let row = s.discovery.row("encoder_offset").unwrap();
@@ -1639,7 +1658,7 @@ fn a_named_offsets_interval_counts_each_runs_zeroing_error() {
 /// have judged it (E_θ −22.6 % ± 8.6 %): named within 10 %.
 #[test]
 fn a_named_breakaway_is_sized_on_every_runs_trajectories() {
-    let (truth, spec, base, a, b, mu) = draw_scaled("stribeck", &mut rng(702_203), 1.0);
+    let (truth, spec, base, a, b, mu) = draw_scaled("stribeck", &mut rng(702_203), 1.0, None);
     let s = discover(706_203, base, a, b, mu, &spec);
     assert_found(&s, "stribeck", truth, 0.10, 0.0);
     let row = s.discovery.row("stribeck").unwrap();
@@ -1656,7 +1675,7 @@ fn a_named_breakaway_is_sized_on_every_runs_trajectories() {
 /// rest is judged on the segments where the pendulum moves: named within 10 %.
 #[test]
 fn a_viscous_damping_is_judged_where_the_pendulum_moves() {
-    let (truth, spec, base, a, b, mu) = draw_scaled("viscous_linear", &mut rng(801_204), 1.0);
+    let (truth, spec, base, a, b, mu) = draw_scaled("viscous_linear", &mut rng(801_204), 1.0, None);
     let s = discover(805_204, base, a, b, mu, &spec);
     let accepted = s.discovery.accepted();
     assert_eq!(accepted, ["viscous_linear"], "hidden b {truth:.4e} N·s/m");
@@ -1674,7 +1693,8 @@ fn a_viscous_damping_is_judged_where_the_pendulum_moves() {
 /// held-out rows reject is none: named alone, within 10 %, and nothing unexplained.
 #[test]
 fn a_departure_the_validate_runs_reject_is_not_reported_beside_a_named_dry_torque() {
-    let (truth, spec, base, a, b, mu) = draw_scaled("coulomb_constant", &mut rng(701_404), 1.0);
+    let (truth, spec, base, a, b, mu) =
+        draw_scaled("coulomb_constant", &mut rng(701_404), 1.0, None);
     let s = discover(705_404, base, a, b, mu, &spec);
     let accepted = s.discovery.accepted();
     assert_eq!(accepted, ["coulomb_constant"], "hidden T_c {truth:.4e} N·m");
@@ -1699,7 +1719,7 @@ fn a_departure_the_validate_runs_reject_is_not_reported_beside_a_named_dry_torqu
 /// breakaway; the breakaway's row says why it was not tried.
 #[test]
 fn a_constant_dry_torque_is_not_named_as_a_breakaway_it_equals() {
-    let (truth, spec, base, a, b, mu) = draw_scaled("coulomb_constant", &mut rng(1401), 0.4);
+    let (truth, spec, base, a, b, mu) = draw_scaled("coulomb_constant", &mut rng(1401), 0.4, None);
     let s = discover(5401, base, a, b, mu, &spec);
     let accepted = s.discovery.accepted();
     assert!(
@@ -1724,7 +1744,7 @@ fn a_constant_dry_torque_is_not_named_as_a_breakaway_it_equals() {
 /// is the catalogue's `coulomb_constant`, tried and not named.
 #[test]
 fn a_description_in_a_catalogue_entrys_shape_says_which() {
-    let (truth, spec, base, a, b, mu) = draw_scaled("coulomb_constant", &mut rng(1402), 0.4);
+    let (truth, spec, base, a, b, mu) = draw_scaled("coulomb_constant", &mut rng(1402), 0.4, None);
     let s = discover(5402, base, a, b, mu, &spec);
     let d = &s.discovery;
     if d.accepted() == ["coulomb_constant"] {
@@ -1785,6 +1805,9 @@ fn survey_issue_5_every_effect() {
         .ok()
         .and_then(|v| v.parse().ok())
         .unwrap_or(1.0);
+    // `SURVEY_DAMPING=drawn` draws the rig's own damping per campaign as well (see
+    // [`draw_scaled`]); by default every campaign has the study's a = 0, b = 0.5, μ = 0.15.
+    let drawn_damping = std::env::var("SURVEY_DAMPING").is_ok_and(|v| v == "drawn");
     // `SURVEY_ONE=effect:k` re-runs one campaign of the survey (`SURVEY_KEEP=DIR` keeps it).
     let one = std::env::var("SURVEY_ONE").ok();
     let off = survey_seed_offset();
@@ -1797,7 +1820,13 @@ fn survey_issue_5_every_effect() {
                 continue;
             }
             let mut r = rng(1000 + 100 * e_idx as u64 + k + off);
-            let (truth, spec, base, a, b, mu) = draw_scaled(effect, &mut r, size_scale);
+            let mut damping = rng(9000 + 100 * e_idx as u64 + k + off);
+            let (truth, spec, base, a, b, mu) = draw_scaled(
+                effect,
+                &mut r,
+                size_scale,
+                drawn_damping.then_some(&mut damping),
+            );
             let dir = tempfile::tempdir().unwrap();
             let seed = 5000 + 100 * e_idx as u64 + k + off;
             let s = discover_in(dir.path(), seed, base, a, b, mu, &spec);
@@ -1837,7 +1866,12 @@ fn survey_issue_5_every_effect() {
                 holding += usize::from(holds);
             }
             eprintln!(
-                "survey-every {effect} k={k} truth={truth:.4e} estimate={est:.4e} ({:+.1} %) interval=[{:.4e}, {:.4e}]{}{} gain={:.1} % ± {:.1} % eq={:.1} % accepted={accepted:?} unexplained={}{}",
+                "survey-every {effect} k={k}{} truth={truth:.4e} estimate={est:.4e} ({:+.1} %) interval=[{:.4e}, {:.4e}]{}{} gain={:.1} % ± {:.1} % eq={:.1} % accepted={accepted:?} unexplained={}{}",
+                if drawn_damping {
+                    format!(" a={a:.3} b={b:.3} mu={mu:.3}")
+                } else {
+                    String::new()
+                },
                 100.0 * (est / truth - 1.0),
                 row.map_or(f64::NAN, |r| r.ci_low),
                 row.map_or(f64::NAN, |r| r.ci_high),
