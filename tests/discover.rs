@@ -455,21 +455,36 @@ fn survey_issue_5_false_alarm_rate() {
         .unwrap_or(8);
     let off = survey_seed_offset();
     let mut r = rng(40 + off);
+    // `SURVEY_DAMPING=drawn` also draws a quadratic drag a (0–0.1 kg/m, as the every-effect
+    // survey's drawn damping) from a stream of its own; by default a = 0 and the b, μ draws are
+    // the same either way.
+    let mut drag = rng(9040 + off);
+    let drawn_drag = std::env::var("SURVEY_DAMPING").is_ok_and(|v| v == "drawn");
     let (mut alarms, mut unexplained) = (0, 0);
     // `SURVEY_ONE=fa:k` re-runs campaign k alone (`SURVEY_KEEP=DIR` keeps it).
     let one = std::env::var("SURVEY_ONE").ok();
     for k in 0..n {
         let b = r.random_range(0.3..0.7);
         let mu = r.random_range(0.08..0.2);
+        let a = if drawn_drag {
+            drag.random_range(0.0..0.1)
+        } else {
+            0.0
+        };
         if one.as_deref().is_some_and(|o| o != format!("fa:{k}")) {
             continue;
         }
-        let s = discover(300 + k + off, Base::Reference, 0.0, b, mu, "");
+        let s = discover(300 + k + off, Base::Reference, a, b, mu, "");
         let accepted = s.discovery.accepted();
         alarms += usize::from(!accepted.is_empty());
         unexplained += usize::from(s.discovery.unexplained.is_some());
         eprintln!(
-            "survey k={k} b={b:.3} mu={mu:.3} accepted={accepted:?} unexplained={:?}",
+            "survey k={k}{} b={b:.3} mu={mu:.3} accepted={accepted:?} unexplained={:?}",
+            if drawn_drag {
+                format!(" a={a:.3}")
+            } else {
+                String::new()
+            },
             s.discovery.unexplained
         );
     }
