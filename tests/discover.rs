@@ -241,6 +241,15 @@ fn found_when_hidden(effect: &str, tag: u64, seed: u64) -> DiscoverSummary {
     s
 }
 
+/// A survey draw again (`effect` drawn as in [`draw`] from `tag`, the twin campaign from `seed`):
+/// discover names it alone within the survey's 10 %. Returns the truth and the summary.
+fn found_as_surveyed(effect: &str, tag: u64, seed: u64) -> (f64, DiscoverSummary) {
+    let (truth, spec, base, a, b, mu) = draw(effect, &mut rng(tag));
+    let s = discover(seed, base, a, b, mu, &spec);
+    assert_found(&s, effect, truth, 0.10, 0.0);
+    (truth, s)
+}
+
 #[test]
 #[ignore = "slow set (one fixed twin draw with nothing hidden; the false-alarm survey draws 50): the default suite checks that nothing is named on independent::issue_12_independent_i00_none, i01 and i11 and in the twin regressions with nothing hidden; README, Tests"]
 fn regression_issue_5_nothing_hidden_nothing_named() {
@@ -1587,9 +1596,7 @@ fn a_breakaway_shape_is_chosen_again_once_each_runs_zeroing_error_is_held() {
 /// validate runs' own size beside the identify runs'.
 #[test]
 fn a_torque_is_sized_on_the_validate_runs_with_their_own_encoder_zeros_free() {
-    let (truth, spec, base, a, b, mu) = draw_scaled("position_torque", &mut rng(1500), 1.0, None);
-    let s = discover(5500, base, a, b, mu, &spec);
-    assert_found(&s, "position_torque", truth, 0.10, 0.0);
+    let (_, s) = found_as_surveyed("position_torque", 1500, 5500);
     let row = s.discovery.row("position_torque").unwrap();
     assert!(row.note.contains("the validate runs alone"), "{}", row.note);
 }
@@ -1643,9 +1650,7 @@ fn a_named_breakaway_is_refitted_on_the_validate_runs_free_segments_too() {
 /// truth, the identify runs' own value kept beside it.
 #[test]
 fn a_lag_the_resting_identify_runs_size_loosely_is_sized_on_every_run_once_named() {
-    let (truth, spec, base, a, b, mu) = draw_scaled("accel_delay", &mut rng(701_902), 1.0, None);
-    let s = discover(705_902, base, a, b, mu, &spec);
-    assert_found(&s, "accel_delay", truth, 0.10, 0.0);
+    let (truth, s) = found_as_surveyed("accel_delay", 701_902, 705_902);
     let row = s.discovery.row("accel_delay").unwrap();
     assert!(
         (row.identify_estimate - truth).abs() > 0.10 * truth,
