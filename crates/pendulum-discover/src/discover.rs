@@ -2726,13 +2726,21 @@ pub fn discover(
         let eq_judges = !nonlinear || effect.kind() == Kind::Observation;
         let eq_contradicts = eq_judges && eq_gain < 0.0 && (eq_powered || eq_gain < -eq_noise);
         // (Both this rule and the next hold only where that view could see the candidate,
-        // `eq_powered`.)
+        // `eq_powered`, but for an offset's silence, below.)
         // Where that direct view neither rises nor confirms (its fall within its noise), the
         // E_θ fall stands alone and must clear its bar by the second look's margin: one view's
         // bare pass is not two views agreeing. A k = 27 cogging torque (2.5e-3 N·m) was named
         // beside a hidden constant dry torque on an E_θ fall of 10.0 % against 9.5 % needed,
         // the validate runs' equation error falling 0.9 % (8.3 % needed).
-        let eq_silent = eq_judges && eq_gain <= eq_needed && eq_powered;
+        // An encoder offset's own column is what each validate run's zero refit takes
+        // ([`eq_reach`]): that view confirms it only through what the offset frees the other
+        // terms to fit, never by its own column, so where it does not confirm, the E_θ fall
+        // stands alone however little that view could see. An off-centre code disc (a
+        // departure) was named a 7.7e-3 rad offset on an E_θ fall of 9.3 % ± 8.6 % while the
+        // validate runs' equation error rose 2.6 %; a −0.032 rad offset beside an extra inertia
+        // takes 94.5 % ± 17.2 % off their E_θ while that error moves −0.04 % (noise 0.08 %).
+        let eq_silent =
+            eq_judges && eq_gain <= eq_needed && (eq_powered || effect.kind() == Kind::Observation);
         let e_theta_alone = gain > gain_needed
             && !eq_contradicts
             && (!eq_silent || gain > SECOND_LOOK_GAIN_FACTOR * gain_needed);
