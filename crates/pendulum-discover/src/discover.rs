@@ -2313,10 +2313,10 @@ pub fn discover(
     // The pair look (see [`PairLook`]): set while its first candidate is held provisionally.
     let mut pair: Option<PairLook> = None;
     let mut pair_tried = false;
-    // The candidate held back in the first round (see `held_back`), once per campaign.
+    // The candidate held back in the first round (see `held_back`), once per campaign: its
+    // screening while it waits, and its name (kept once it is judged again).
     let mut deferred: Option<Screened> = None;
     let mut deferred_effect: Option<String> = None;
-    let mut deferral_used = false;
     loop {
         let sc = match next.take() {
             Some(sc) => sc,
@@ -2898,13 +2898,17 @@ pub fn discover(
         // parameter off the end of the search range that held it? (It may leave another at an
         // end: on a heavily damped design whose runs mostly rest, a refit freeing b and μ traded
         // b for the quadratic drag a, at its bound, while the offset it held was right to 0.3 %.)
-        let unpins = !look_pins.is_empty()
-            && look_pins.iter().all(|&(p, side)| {
+        let still_pinned: Vec<FitParam> = look_pins
+            .iter()
+            .filter(|&&(p, side)| {
                 spec.params
                     .iter()
                     .position(|&q| q == p)
-                    .is_none_or(|i| look_spec.at_end(p, x[i]) != Some(side))
-            });
+                    .is_some_and(|i| look_spec.at_end(p, x[i]) == Some(side))
+            })
+            .map(|&(p, _)| p)
+            .collect();
+        let unpins = !look_pins.is_empty() && still_pinned.is_empty();
         // A breakaway's screen on the second look ran at the shape its own profile chose, which
         // is blind where the shape acts (see [`shape_start`]); at the shape the trajectories
         // chose, the identify runs' equation error is a second view of the same runs. Where it
@@ -3120,14 +3124,13 @@ pub fn discover(
             && round == 0
             && pair.is_none()
             && !unpins
-            && !deferral_used
+            && deferred_effect.is_none()
             && queue
                 .iter()
                 .any(|b| b.candidate.effect != c.effect && b.delta_bic < cfg.screen_threshold);
         let accepted = accepted && !held_back;
-        let judged_again = deferral_used
-            && deferred.is_none()
-            && deferred_effect.as_deref() == Some(c.effect.as_str());
+        let judged_again =
+            deferred.is_none() && deferred_effect.as_deref() == Some(c.effect.as_str());
         // The pair look's first candidate: refused on the held-out views alone, everything else
         // passed, and the next screened candidate (not shaped, another effect) beside it. Each
         // one's held-out equation-error fall beside the other's column must clear its own bar.
@@ -3367,16 +3370,7 @@ pub fn discover(
         };
         let mut row = row;
         if held_back {
-            let still: Vec<&str> = look_pins
-                .iter()
-                .filter(|&&(p, side)| {
-                    spec.params
-                        .iter()
-                        .position(|&q| q == p)
-                        .is_some_and(|i| look_spec.at_end(p, x[i]) == Some(side))
-                })
-                .map(|&(p, _)| p.name())
-                .collect();
+            let still: Vec<&str> = still_pinned.iter().map(|p| p.name()).collect();
             row.note.push_str(&format!(
                 "; passed the screen route, but the base model's fit was pinned at its search range and with it the refit still leaves {} at the bound that pinned it: held back while the round's other screened candidates are judged",
                 still.join(", ")
@@ -3587,7 +3581,6 @@ pub fn discover(
             }
         }
         if held_back {
-            deferral_used = true;
             deferred = Some(sc.clone());
             deferred_effect = Some(c.effect.clone());
         }
