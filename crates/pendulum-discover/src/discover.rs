@@ -2826,10 +2826,11 @@ pub fn discover(
         // generator screened at 6.7e-5 N·m·s/rad [3.0e-5, 2.1e-4] was refitted at 3.4e-9 (the
         // trajectories could not tell it from its absence; the validate runs' E_θ moved 0.05 %)
         // and "agreed" within the upper side's 1.5e-4, and was named on its equation-error fall.
+        let (below_half, above_half) = ((1.96 * se).max(est - ci.0), (1.96 * se).max(ci.1 - est));
         let agree_half = if refit_est < est {
-            (1.96 * se).max(est - ci.0)
+            below_half
         } else {
-            (1.96 * se).max(ci.1 - est)
+            above_half
         };
         let agree = lag_silent
             || (!refit_pinned
@@ -3596,7 +3597,7 @@ pub fn discover(
             pair_tried = true;
             pair = Some(PairLook {
                 first: c.effect.clone(),
-                first_screen: pulled.then_some((est, (1.96 * se).max(est - ci.0).max(ci.1 - est))),
+                first_screen: pulled.then_some((est, below_half.max(above_half))),
                 first_eq_beside: eq,
                 second: b,
                 before: before_val.clone(),
