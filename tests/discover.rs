@@ -140,8 +140,8 @@ fn assert_found(s: &DiscoverSummary, effect: &str, truth: f64, rel: f64, abs: f6
 }
 
 /// The surveys' `SURVEY_SEED` (default 0) as an offset to every draw's tag and campaign seed:
-/// other seeds draw other designs, sizes and damping, none of them the ones the README quotes
-/// (tags and seeds stay below 100 000 at seed 0).
+/// each seed draws other designs, sizes and damping, as a held-out set would (tags and seeds
+/// stay below 100 000 at seed 0).
 fn survey_seed_offset() -> u64 {
     100_000
         * std::env::var("SURVEY_SEED")
@@ -856,7 +856,7 @@ fn issue_14_second_look_names_the_breakaway_not_a_constant_dry_torque() {
 }
 
 /// The same draw's size: the trajectory refit's T_s is 5.45e-3 N·m, −50 % of the truth, and
-/// the survey's named breakaways are off by −36 % and +19 % too (README): the refit trades T_s
+/// the survey's named breakaways are off by −36 % and +19 % too (docs/discovery-log.md): the refit trades T_s
 /// against v_s and μ, and the screen's value against v_s.
 #[test]
 #[ignore = "known failure (issue 14): on 97f6dd9 this draw's breakaway is not named (refit 6.82e-3 N·m; the trajectories cannot tell it from its absence); it was named 50 % low before; see the doc comment"]

@@ -384,7 +384,7 @@ fn a_bouncing_bob_is_unexplained_and_follows_the_rate() {
 /// 0.817 N·m against 0.082), so one size does not
 /// describe the departure and nothing may be named; the refused row's note gives both values.
 #[test]
-#[ignore = "slow set (two kept draws, 50 s on 2 cores): the default suite checks a bouncing bob on a_bouncing_bob_is_unexplained_and_follows_the_rate and the rule on the unit test sizes_disagree_only_apart_beyond_both_intervals_and_the_promised_accuracy; README, A partial explanation is not a cause"]
+#[ignore = "slow set (two kept draws, 50 s on 2 cores): the default suite checks a bouncing bob on a_bouncing_bob_is_unexplained_and_follows_the_rate and the rule on the unit test sizes_disagree_only_apart_beyond_both_intervals_and_the_promised_accuracy; docs/discovery.md, A partial explanation is not a cause"]
 fn a_bouncing_bob_whose_validate_runs_size_it_elsewhere_is_not_named() {
     for (k, off) in [(3, 100_000), (2, 500_000)] {
         let (seed, b, mu, departure) = drawn_departure("bob_bounce", k, off);
@@ -419,7 +419,7 @@ fn a_bouncing_bob_whose_validate_runs_size_it_elsewhere_is_not_named() {
 /// makes the extended model ten times worse on the runs the fit never saw is not excused, and
 /// nothing may be named. The refused row says why.
 #[test]
-#[ignore = "slow set (one kept draw, 50 s on 2 cores): the default suite checks a bouncing bob on a_bouncing_bob_is_unexplained_and_follows_the_rate and the excused trade on a_lag_the_validate_runs_e_theta_cannot_see_is_judged_on_their_equation_error; README, A partial explanation is not a cause"]
+#[ignore = "slow set (one kept draw, 50 s on 2 cores): the default suite checks a bouncing bob on a_bouncing_bob_is_unexplained_and_follows_the_rate and the excused trade on a_lag_the_validate_runs_e_theta_cannot_see_is_judged_on_their_equation_error; docs/discovery.md, A partial explanation is not a cause"]
 fn a_bouncing_bob_whose_lag_makes_the_held_out_runs_worse_is_not_named() {
     let (seed, b, mu, departure) = drawn_departure("bob_bounce", 1, 100_000);
     let s = discover_with(seed, b, mu, &departure);
@@ -447,7 +447,7 @@ fn a_bouncing_bob_whose_lag_makes_the_held_out_runs_worse_is_not_named() {
 /// judged it, and one view's bare pass is not two views agreeing: nothing may be named, and the
 /// lag's row says why.
 #[test]
-#[ignore = "slow set (one kept draw, 25 s on 2 cores): the default suite checks the lone view's margin on a_lag_the_validate_runs_e_theta_cannot_see_is_judged_on_their_equation_error (a true lag through it) and a growing friction on regression_issue_12_growing_dry_torque_is_unexplained; README, An input effect the validate runs' E_θ cannot see"]
+#[ignore = "slow set (one kept draw, 25 s on 2 cores): the default suite checks the lone view's margin on a_lag_the_validate_runs_e_theta_cannot_see_is_judged_on_their_equation_error (a true lag through it) and a growing friction on regression_issue_12_growing_dry_torque_is_unexplained; docs/discovery.md, An input effect the validate runs' E_θ cannot see"]
 fn a_growing_friction_is_not_named_a_lag_on_one_views_bare_pass() {
     let (seed, b, mu, departure) = drawn_departure("dry_torque_growth", 0, 500_000);
     let s = discover_with(seed, b, mu, &departure);
@@ -645,7 +645,7 @@ fn drawn_departure(name: &str, k: u64, off: u64) -> (u64, f64, f64, String) {
 /// cause). `DEPARTURE_ONE=name:k` re-runs one (`KEEP_DEP=PREFIX` keeps its case);
 /// `DEPARTURE_SEED=s` draws other campaigns.
 #[test]
-#[ignore = "survey for issue 14 item 3: 8 departures × DEPARTURE_N (default 3) drawn campaigns; ~3 minutes on 2 cores"]
+#[ignore = "survey for issue 14 item 3: 10 departures × DEPARTURE_N (default 3) drawn campaigns; DEPARTURE_N=5 took 1247 s on 2 cores beside another run (1c00f79)"]
 fn survey_departures_name_nothing() {
     let n: u64 = std::env::var("DEPARTURE_N")
         .ok()
