@@ -201,4 +201,46 @@ mod tests {
         let e = load_model(&path, "quadratic").unwrap_err().to_string();
         assert!(e.contains("reference, linear"), "{e}");
     }
+
+    /// A params.parquet someone opened in pandas and saved again comes back snappy-compressed
+    /// (pandas', pyarrow's and DuckDB's default; we write zstd): it reads the same.
+    #[test]
+    fn a_table_saved_by_pandas_reads_the_same() {
+        use parquet::arrow::ArrowWriter;
+        use parquet::basic::Compression;
+        use parquet::file::properties::WriterProperties;
+        let dir = tempfile::tempdir().unwrap();
+        let ours = dir.path().join("params.parquet");
+        let cols = vec![
+            Column::new("model", ColumnData::Str(vec!["reference".into()])),
+            Column::f64("b", "N·s/m", vec![0.5]),
+            Column::f64("mu", "1", vec![0.15]),
+            Column::f64("coulomb_constant.T_c", "N·m", vec![0.004]),
+        ];
+        TableOptions::new().write(&ours, &cols).unwrap();
+        let batches: Vec<_> = ParquetRecordBatchReaderBuilder::try_new(File::open(&ours).unwrap())
+            .unwrap()
+            .build()
+            .unwrap()
+            .map(Result::unwrap)
+            .collect();
+        let theirs = dir.path().join("edited.parquet");
+        let props = WriterProperties::builder()
+            .set_compression(Compression::SNAPPY)
+            .build();
+        let mut w = ArrowWriter::try_new(
+            File::create(&theirs).unwrap(),
+            batches[0].schema(),
+            Some(props),
+        )
+        .unwrap();
+        for b in &batches {
+            w.write(b).unwrap();
+        }
+        w.close().unwrap();
+        assert_eq!(
+            load_model(&theirs, "reference").unwrap(),
+            load_model(&ours, "reference").unwrap()
+        );
+    }
 }
