@@ -250,6 +250,20 @@ fn found_as_surveyed(effect: &str, tag: u64, seed: u64) -> (f64, DiscoverSummary
     (truth, s)
 }
 
+/// A draw of the every-effect survey with the damping drawn (`SURVEY_DAMPING=drawn`): `effect`
+/// from `tag`, the rig's damping from `damping_tag`, the twin campaign from `seed`. Returns the
+/// truth and the summary.
+fn run_as_surveyed_with_damping(
+    effect: &str,
+    tag: u64,
+    damping_tag: u64,
+    seed: u64,
+) -> (f64, DiscoverSummary) {
+    let (truth, spec, base, a, b, mu) =
+        draw_scaled(effect, &mut rng(tag), 1.0, Some(&mut rng(damping_tag)));
+    (truth, discover(seed, base, a, b, mu, &spec))
+}
+
 #[test]
 #[ignore = "slow set (one fixed twin draw with nothing hidden; the false-alarm survey draws 50): the default suite checks that nothing is named on independent::issue_12_independent_i00_none, i01 and i11 and in the twin regressions with nothing hidden; README, Tests"]
 fn regression_issue_5_nothing_hidden_nothing_named() {
@@ -1057,7 +1071,10 @@ fn a_lag_the_validate_runs_e_theta_cannot_see_is_judged_on_their_equation_error(
 /// [5.71, 5.94] and the validate runs confirmed it (E_θ −89 % ± 42 %, equation error −99.7 %),
 /// but the trajectories, hand-start transients and free segments, cannot tell a lag from none:
 /// its refit had wandered to 6.47 ms, 11 % off, and the 10 % band refused it although the profile
-/// through the screen's value fitted them as well. Silent trajectories hold the screen's value.
+/// through the screen's value fitted them as well. Trajectories that cannot size it hold the
+/// screen's value. (With each run's zeroing error held, since 23a5ac7, the refit is 5.95 ms and
+/// the trajectories tell a lag from none, but not the refit's value from the screen's, outside
+/// whose narrow interval it lies: the same holds, by the wandering refit's rule.)
 #[test]
 fn a_lag_the_resting_identify_runs_cannot_size_is_named_at_the_screens_value() {
     let truth = 0.005872606415759924;
@@ -1073,7 +1090,7 @@ fn a_lag_the_resting_identify_runs_cannot_size_is_named_at_the_screens_value() {
     let row = s.discovery.row("accel_delay").unwrap();
     assert_eq!(row.identify_estimate, row.screen_estimate, "{}", row.note);
     assert!(
-        row.note.contains("the trajectories cannot tell its size"),
+        row.note.contains("carries the screen's value"),
         "{}",
         row.note
     );
@@ -1088,7 +1105,9 @@ fn a_lag_the_resting_identify_runs_cannot_size_is_named_at_the_screens_value() {
 /// The candidate the screen passed over is judged in its turn, and a lag whose refit wanders
 /// outside the screen's interval along a flat profile is judged at the screen's value: named,
 /// alone, with the truth inside the screen's interval (its value is 35 % high: the resting runs
-/// leave the screen few forced windows).
+/// leave the screen few forced windows). (With each run's zeroing error held, since 23a5ac7, the
+/// refit goes to 39.7 ms and the trajectories cannot tell it from none: judged at the screen's
+/// value by the silent trajectories' rule.)
 #[test]
 fn a_lag_tied_with_a_refused_tilt_is_judged_and_named_at_the_screens_value() {
     let truth = 0.00791693249123327;
@@ -1114,7 +1133,11 @@ fn a_lag_tied_with_a_refused_tilt_is_judged_and_named_at_the_screens_value() {
         row.ci_high
     );
     assert_eq!(row.identify_estimate, row.screen_estimate, "{}", row.note);
-    assert!(row.note.contains("refit wandered"), "{}", row.note);
+    assert!(
+        row.note.contains("carries the screen's value"),
+        "{}",
+        row.note
+    );
     let tilt = s.discovery.row("horizontal_base").unwrap();
     assert!(!tilt.accepted);
 }
@@ -1641,13 +1664,7 @@ fn a_torque_is_sized_on_the_validate_runs_with_their_own_encoder_zeros_free() {
 /// while the round's others are judged: the offset is named within 2 mrad, and the torque not.
 #[test]
 fn an_offset_is_not_named_a_torque_that_leaves_the_base_pinned() {
-    let (truth, spec, base, a, b, mu) = draw_scaled(
-        "encoder_offset",
-        &mut rng(101_801),
-        1.0,
-        Some(&mut rng(109_801)),
-    );
-    let s = discover(105_801, base, a, b, mu, &spec);
+    let (truth, s) = run_as_surveyed_with_damping("encoder_offset", 101_801, 109_801, 105_801);
     assert_found(&s, "encoder_offset", truth, 0.0, 0.002);
     let row = s.discovery.row("position_torque").unwrap();
     assert!(row.note.contains("held back"), "{}", row.note);
@@ -1664,13 +1681,7 @@ fn an_offset_is_not_named_a_torque_that_leaves_the_base_pinned() {
 /// held as a nuisance, as for a torque, named within the score's 0.5 ms.
 #[test]
 fn a_lag_is_not_refused_by_trajectories_whose_run_is_zeroed_off_by_counts() {
-    let (truth, spec, base, a, b, mu) = draw_scaled(
-        "accel_delay",
-        &mut rng(201_901),
-        1.0,
-        Some(&mut rng(209_901)),
-    );
-    let s = discover(205_901, base, a, b, mu, &spec);
+    let (truth, s) = run_as_surveyed_with_damping("accel_delay", 201_901, 209_901, 205_901);
     assert_found(&s, "accel_delay", truth, 0.0, 5e-4);
 }
 
