@@ -2595,7 +2595,9 @@ pub fn discover(
         // the refit with the screen's narrow interval and refused it, while the validate runs'
         // E_θ and equation error both fell (82 % ± 47 %, 43.8 % against 34.1 % needed).
         let switch_silent = effect.params().is_empty() && size_index.is_some() && !informative;
-        let silent = run_zeros
+        // (A torque's or an inertia's: the forcing's effects hold the runs' zeros too, but keep
+        // their own bar below, `lag_silent`.)
+        let silent = matches!(effect.kind(), Kind::Dynamics | Kind::Mass)
             && c.shaped().is_none()
             && (size_power == Some(false) || switch_silent)
             && g_prof >= -n_prof;
