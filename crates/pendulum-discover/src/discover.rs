@@ -2432,7 +2432,8 @@ pub fn discover(
         // worse on the trajectories, and refused while the validate runs' equation error fell
         // 99.8 %. (When the zeros were first held, in 037fd0f, holding them for a lag lost one;
         // the lag's own rules have changed since: see `lag_silent`.)
-        let run_zeros = matches!(effect.kind(), Kind::Dynamics | Kind::Mass | Kind::Input);
+        let torque_or_inertia = matches!(effect.kind(), Kind::Dynamics | Kind::Mass);
+        let run_zeros = torque_or_inertia || effect.kind() == Kind::Input;
         // The current model's local refit is cached per kind of refit (tails, zeros).
         let cache = tails + 2 * usize::from(run_zeros);
         // Each refit starts every run from the initial state its own start model follows
@@ -2597,7 +2598,7 @@ pub fn discover(
         let switch_silent = effect.params().is_empty() && size_index.is_some() && !informative;
         // (A torque's or an inertia's: the forcing's effects hold the runs' zeros too, but keep
         // their own bar below, `lag_silent`.)
-        let silent = matches!(effect.kind(), Kind::Dynamics | Kind::Mass)
+        let silent = torque_or_inertia
             && c.shaped().is_none()
             && (size_power == Some(false) || switch_silent)
             && g_prof >= -n_prof;
