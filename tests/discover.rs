@@ -1072,7 +1072,7 @@ fn a_lag_the_validate_runs_e_theta_cannot_see_is_judged_on_their_equation_error(
 /// but the trajectories, hand-start transients and free segments, cannot tell a lag from none:
 /// its refit had wandered to 6.47 ms, 11 % off, and the 10 % band refused it although the profile
 /// through the screen's value fitted them as well. Trajectories that cannot size it hold the
-/// screen's value. (With each run's zeroing error held, since 23a5ac7, the refit is 5.95 ms and
+/// screen's value. (With each run's zeroing error held, since 84d0ad9, the refit is 5.95 ms and
 /// the trajectories tell a lag from none, but not the refit's value from the screen's, outside
 /// whose narrow interval it lies: the same holds, by the wandering refit's rule.)
 #[test]
@@ -1105,7 +1105,7 @@ fn a_lag_the_resting_identify_runs_cannot_size_is_named_at_the_screens_value() {
 /// The candidate the screen passed over is judged in its turn, and a lag whose refit wanders
 /// outside the screen's interval along a flat profile is judged at the screen's value: named,
 /// alone, with the truth inside the screen's interval (its value is 35 % high: the resting runs
-/// leave the screen few forced windows). (With each run's zeroing error held, since 23a5ac7, the
+/// leave the screen few forced windows). (With each run's zeroing error held, since 84d0ad9, the
 /// refit goes to 39.7 ms and the trajectories cannot tell it from none: judged at the screen's
 /// value by the silent trajectories' rule.)
 #[test]
