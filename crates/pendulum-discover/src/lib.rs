@@ -7,5 +7,7 @@ pub mod screen;
 pub mod sparse;
 pub mod weak;
 
-pub use discover::{discover, DiagnosisRow, DiscoverConfig, Discovery};
+pub use discover::{
+    discover, DampingCheck, DampingVerdict, DiagnosisRow, DiscoverConfig, Discovery,
+};
 pub use screen::Base;

@@ -273,6 +273,14 @@ fn run_unmarked(job: &DiscoverJob) -> Result<DiscoverSummary, JobError> {
         ));
     }
     let d = discover(&ctx, job.base, &pipe.discover, &free)?;
+    if let Some(note) = d
+        .damping_check
+        .as_ref()
+        .and_then(|c| c.note(&d.base.spec, &d.base.params))
+    {
+        ctx.notes
+            .push(format!("{}: {}", note.0.to_lowercase(), note.1));
+    }
 
     // Tables shared with identify: params/residuals/... for the base and the extended model.
     ctx.validations
@@ -680,6 +688,7 @@ fn free_decays(
         out_dir: out.clone(),
         report: report_path,
         discovery: Discovery {
+            damping_check: None,
             base: pendulum_process::identify::FitOutcome {
                 spec: pendulum_process::fit::ModelSpec::linear(),
                 params: Vec::new(),
@@ -1256,6 +1265,13 @@ fn write_report(
     let _ = writeln!(r, "## Base model\n");
     for (p, v) in d.base.spec.params.iter().zip(&d.base.params) {
         let _ = writeln!(r, "- {} = {:.5} {}", p.name(), v, p.unit());
+    }
+    if let Some(note) = d
+        .damping_check
+        .as_ref()
+        .and_then(|c| c.note(&d.base.spec, &d.base.params))
+    {
+        let _ = writeln!(r, "\n**{}.** {}.", note.0, note.1);
     }
     let _ = writeln!(r, "\n## Diagnosis\n\nOne row per catalogue candidate screened (ΔBIC of the weak-form equation error on the identify runs); the best are refitted on the trajectories and accepted only if their 95 % interval excludes zero and the error on the validate runs, which neither the screen nor the refit saw, falls by more than chance explains: E_θ by more than max(2 %, its noise), or the equation error by more than max(5 %, its noise) while E_θ does not rise by more than its noise. Where the validate runs' equation error could see the candidate (the fall it would show were the candidate true at the screen's size clears its bar) but does not confirm it, E_θ's fall must be twice its bar, and any rise of that equation error refuses it; where it could not, it neither confirms nor contradicts. A fall's noise is 1.96 × its standard error from the paired differences of the validate runs' 0.5 s shooting segments (E_θ) or weak-form windows (equation error); `gain ± noise` and `eq gain` in the table. Two more conditions: the estimate is physically possible (no negative damping, dry torque or inertia), and the trajectory refit (`refit`) agrees with the screen's estimate, within its interval or 10 %, whichever is wider.\n\n```\n{table}```\n");
     if !d.forcing_not_understood.is_empty() {
