@@ -2046,9 +2046,12 @@ pub struct DampingCheck {
 /// `a_damping_split_the_shaken_runs_leave_open_is_pinned_by_the_free_swings`).
 pub const DAMPING_CHECK_MIN_FALL: f64 = 0.25;
 
-/// The most a joint damping may follow either part (the free segments, the forced windows) worse
-/// than that part's own fit, beside the noise, and still be one both accept: the held-out E_θ
-/// bar's order of size.
+/// A part (the free segments, the forced windows) refuses a joint damping when it follows that
+/// part worse than the part's own fit by more than twice this and twice the noise: the second
+/// look's factor on the held-out E_θ bar's order of size. With nothing hidden, refusals at about
+/// once the noise (E_θ 14.6 % ± 11.8 %, 103.5 % ± 97.4 %) said "a loss the model lacks" in 3 of
+/// the false-alarm survey's first 40 campaigns with the drag drawn (`SURVEY_SEED=10`); a hidden
+/// bearing load that acts only while the shaker runs was refused at 200 % ± 81 %.
 pub const DAMPING_CHECK_JOINT_TOLERANCE: f64 = 0.10;
 
 /// How [`DampingCheck`] reads.
@@ -2057,7 +2060,8 @@ pub enum DampingVerdict {
     /// The free segments follow the base fit's damping about as well as their own.
     Agrees,
     /// The free segments reject the base's damping, and one damping fits both them and the
-    /// forced windows: the forced windows left the split among the terms open.
+    /// forced windows (neither refuses it beyond twice its noise): the forced windows left the
+    /// split among the terms open.
     NotPinned,
     /// No one damping of the base model fits both the free swings and the shaken runs.
     Disagrees,
@@ -2066,14 +2070,14 @@ pub enum DampingVerdict {
 impl DampingCheck {
     /// See [`DampingVerdict`]. The free segments reject the base's damping when their E_θ under
     /// it is above their own fit's by more than its noise and [`DAMPING_CHECK_MIN_FALL`]; a part
-    /// accepts the joint damping when its E_θ under it is worse than under its own fit by no
-    /// more than its noise or [`DAMPING_CHECK_JOINT_TOLERANCE`], whichever is larger.
+    /// refuses the joint damping when its E_θ under it is worse than under the part's own fit
+    /// by more than twice its noise and twice [`DAMPING_CHECK_JOINT_TOLERANCE`].
     pub fn verdict(&self) -> DampingVerdict {
         let (g, n) = self.free_gain;
         if g <= n.max(DAMPING_CHECK_MIN_FALL) {
             return DampingVerdict::Agrees;
         }
-        let accepts = |(g, n): (f64, f64)| g >= -n.max(DAMPING_CHECK_JOINT_TOLERANCE);
+        let accepts = |(g, n): (f64, f64)| g >= -2.0 * n.max(DAMPING_CHECK_JOINT_TOLERANCE);
         if accepts(self.joint_on_free) && accepts(self.joint_on_forced) {
             DampingVerdict::NotPinned
         } else {
@@ -2112,7 +2116,7 @@ impl DampingCheck {
             DampingVerdict::NotPinned => Some((
                 "Damping not pinned by the forced runs",
                 format!(
-                    "{head}. One damping fits both, {} (on the forced windows, from the base's, {}; on the free segments, from their own, {}): the forced windows left the split of the damping among its terms open and the fit chose one; the free swings pin it. Read the joint damping, or add identify runs that swing or rotate under their shaking",
+                    "{head}. One damping fits both, {} (on the forced windows, from the base's, {}; on the free segments, from their own, {}; neither refuses it beyond twice its noise): the forced windows left the split of the damping among its terms open and the fit chose one; the free swings pin it. Read the joint damping, or add identify runs that swing or rotate under their shaking",
                     list(&self.joint_params),
                     pct(self.joint_on_forced),
                     pct(self.joint_on_free)
@@ -3340,6 +3344,25 @@ pub fn discover(
                 .iter()
                 .any(|b| b.candidate.effect != c.effect && b.delta_bic < cfg.screen_threshold);
         let accepted = accepted && !held_back;
+        // A generalisation (a breakaway, which becomes a constant dry torque as v_s grows past
+        // the swings' speeds) no better on the validate runs' E_θ than the effect it generalises,
+        // judged and refused before it: it stands for that effect at the limit of its shape, and
+        // naming it would pass what the held-out views refused under the simpler name. A hidden
+        // 1.09e-2 N·m constant dry torque on a drawn design (the every-effect survey's
+        // `coulomb_constant` k=0, `SURVEY_DAMPING=drawn SURVEY_SEED=3`) took 64.8 % ± 44.1 % off
+        // the validate runs' E_θ, short of twice its bar where their equation error (80.7 %
+        // against 93.1 %) did not confirm it, and was refused; a breakaway refitted at
+        // v_s = 3.8 rad/s (T_s 1.04e-2) then took 56.3 % ± 39.2 %, its equation error at the
+        // screen's shape judged blind, and was named.
+        let outdone_by_simpler = effect
+            .generalises()
+            .and_then(|g| confirmed.iter().rev().find(|(e, _)| e == g))
+            .map(|(_, r)| r)
+            .filter(|r| {
+                accepted && !r.accepted && r.heldout_gain.is_finite() && r.heldout_gain >= gain
+            })
+            .map(|r| (r.effect.clone(), r.heldout_gain));
+        let accepted = accepted && outdone_by_simpler.is_none();
         let judged_again =
             deferred.is_none() && deferred_effect.as_deref() == Some(c.effect.as_str());
         // The pair look's first candidate: refused on the held-out views alone, everything else
@@ -3590,6 +3613,13 @@ pub fn discover(
             row.note.push_str(
                 "; judged again after it was held back (the base pinned, its refit not freeing it) and no other screened candidate was named",
             );
+        }
+        if let Some((simpler, g)) = &outdone_by_simpler {
+            row.note.push_str(&format!(
+                "; it does no better on the validate runs' E_θ ({:.1} %) than the {simpler} it becomes at the limit of its shape, which the held-out views refused ({:.1} %): not named",
+                100.0 * gain,
+                100.0 * g
+            ));
         }
         if switch_silent && silent {
             row.note.push_str(
