@@ -2744,3 +2744,44 @@ fn a_breakaway_no_better_than_the_refused_constant_torque_it_becomes_is_not_name
         s.discovery.rows
     );
 }
+
+/// The every-effect survey's offset + inertia pair at `SURVEY_SEED=3` (0.0365 rad and
+/// 1.29e-2 kg·m², the base fit pinned at μ's bound): the inertia was held back while the base
+/// stayed pinned, the offset refused (its screen beside the base alone, the inertia missing, put
+/// it at 7.3e-2 [−0.3e-2, 14.9e-2]), and a k = 1 position torque of 0.41 N·m named in their
+/// place, which the identify and the validate rows, beside the two, each put at 3.5e-4 and
+/// 3.8e-4 N·m. A candidate that stands in for the others is not named; the inertia and the
+/// offset are, the offset within 2 mrad and the inertia within 10 %.
+#[test]
+fn a_position_torque_standing_in_for_an_offset_and_an_inertia_is_not_named() {
+    let off = 300_000;
+    let mut r = rng(3000 + 2 + off);
+    let (t_off, s_off, ..) = draw("encoder_offset", &mut r);
+    let (t_j, s_j, ..) = draw("extra_inertia", &mut r);
+    let s = discover(
+        7000 + 2 + off,
+        Base::Reference,
+        0.0,
+        0.5,
+        0.15,
+        &format!("{s_off}\n{s_j}"),
+    );
+    let mut accepted = s.discovery.accepted();
+    accepted.sort_unstable();
+    assert_eq!(
+        accepted,
+        ["encoder_offset", "extra_inertia"],
+        "{:#?}",
+        s.discovery.rows
+    );
+    let off_est = s.discovery.row("encoder_offset").unwrap().estimate;
+    assert!(
+        (off_est - t_off).abs() <= 0.002,
+        "offset {off_est:.4e} against {t_off:.4e}"
+    );
+    let j = s.discovery.row("extra_inertia").unwrap().estimate;
+    assert!(
+        (j - t_j).abs() <= 0.10 * t_j,
+        "inertia {j:.4e} against {t_j:.4e}"
+    );
+}
