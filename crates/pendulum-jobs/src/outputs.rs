@@ -6,11 +6,8 @@
 
 use std::collections::BTreeSet;
 use std::fmt::Write as _;
-use std::fs::File;
 use std::path::{Path, PathBuf};
 
-use arrow_array::{Array, Float64Array, Int64Array, StringArray};
-use parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
 use pendulum_model::Effects;
 use pendulum_plot::{Figure, Panel, Series, SeriesStyle};
 use pendulum_process::fit::{FitParam, ModelSpec};
@@ -518,103 +515,80 @@ fn free_decay_row(
 /// Reads one model back from a params.parquet (the first row, or the row named `model`).
 pub fn read_params(path: &Path, model: Option<&str>) -> Result<FitOutcome, JobError> {
     let bad = |m: String| JobError::Invalid(format!("{}: {m}", path.display()));
-    let file = File::open(path).map_err(|source| JobError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
-    let reader = ParquetRecordBatchReaderBuilder::try_new(file)
-        .map_err(|e| bad(format!("not a Parquet file: {e}")))?
-        .build()
-        .map_err(|e| bad(e.to_string()))?;
-    for batch in reader {
-        let batch = batch.map_err(|e| bad(e.to_string()))?;
-        let names = batch
-            .column_by_name("model")
-            .and_then(|c| c.as_any().downcast_ref::<StringArray>().cloned())
-            .ok_or_else(|| bad("no Utf8 column `model`: expected a params.parquet written by pendulum identify".into()))?;
-        for row in 0..batch.num_rows() {
-            let name = names.value(row).to_string();
-            if model.is_some_and(|m| m != name) {
-                continue;
-            }
-            let get = |col: &str| -> Option<f64> {
-                let c = batch.column_by_name(col)?;
-                if let Some(a) = c.as_any().downcast_ref::<Float64Array>() {
-                    return (!a.is_null(row)).then(|| a.value(row));
-                }
-                c.as_any()
-                    .downcast_ref::<Int64Array>()
-                    .map(|a| a.value(row) as f64)
-            };
-            let base = if name.starts_with("linear") {
-                ModelSpec::linear()
-            } else if name.starts_with("dry") {
-                ModelSpec::dry()
-            } else {
-                ModelSpec::reference()
-            };
-            let mut spec = ModelSpec {
-                name: name.clone(),
-                params: base.params.clone(),
-                fixed: Effects::default(),
-                ranges: Default::default(),
-            };
-            let given = |p: FitParam| get(p.name()).is_some_and(|v| !v.is_nan());
-            // One column per refitted parameter of the catalogue, in its order.
-            for p in FitParam::all_effects() {
-                if given(p) {
-                    spec.params.push(p);
-                }
-            }
-            for (key, _) in held_params() {
-                if let Some(v) = get(key).filter(|v| v.is_finite()) {
-                    spec.fixed.set_value(key, v);
-                }
-            }
-            // A free-decay row (it has ω0): the same model in identifiable terms.
-            if given(FitParam::Omega0) {
-                if given(FitParam::DryC) {
-                    spec.params.push(FitParam::of("coulomb_constant"));
-                }
-                spec = spec
-                    .free_decay()
-                    .map_err(|e| bad(format!("model {name}: {e}")))?;
-            }
-            let params = spec
-                .params
-                .iter()
-                .map(|p| {
-                    get(p.name())
-                        .ok_or_else(|| bad(format!("model {name}: no column {}", p.name())))
-                })
-                .collect::<Result<Vec<f64>, _>>()?;
-            // A fit may have widened a search range past the catalogue's: its values hold.
-            for (&p, &v) in spec.params.clone().iter().zip(&params) {
-                spec.hold(p, v);
-            }
-            return Ok(FitOutcome {
-                spec,
-                params,
-                f_obj: get("f_obj").unwrap_or(f64::NAN),
-                e_theta: get("e_theta").unwrap_or(f64::NAN),
-                generations: get("generations").unwrap_or(0.0) as u64,
-                evaluations: get("evaluations").unwrap_or(0.0) as u64,
-                abandoned: 0,
-                stop_reason: "given".into(),
-                wall_s: 0.0,
-                seed: get("seed").unwrap_or(0.0) as u64,
-                np: get("np").unwrap_or(0.0) as usize,
-                convergence: Vec::new(),
-                runs: Vec::new(),
-                polished: None,
-                alignments: Default::default(),
-            });
+    // One reader of the table for every command (`design` reads it the same way): any numeric
+    // column type, and tables saved again by pandas, pyarrow or DuckDB.
+    let rows = pendulum_maps::params_file::read_params(path)?;
+    let Some(row) = rows
+        .into_iter()
+        .find(|r| model.is_none_or(|m| m == r.model))
+    else {
+        return Err(bad(match model {
+            Some(m) => format!("no model named {m:?}"),
+            None => "no rows".into(),
+        }));
+    };
+    let name = row.model.clone();
+    let get = |col: &str| row.get(col);
+    let base = if name.starts_with("linear") {
+        ModelSpec::linear()
+    } else if name.starts_with("dry") {
+        ModelSpec::dry()
+    } else {
+        ModelSpec::reference()
+    };
+    let mut spec = ModelSpec {
+        name: name.clone(),
+        params: base.params.clone(),
+        fixed: Effects::default(),
+        ranges: Default::default(),
+    };
+    let given = |p: FitParam| get(p.name()).is_some();
+    // One column per refitted parameter of the catalogue, in its order.
+    for p in FitParam::all_effects() {
+        if given(p) {
+            spec.params.push(p);
         }
     }
-    Err(bad(match model {
-        Some(m) => format!("no model named {m:?}"),
-        None => "no rows".into(),
-    }))
+    for (key, _) in held_params() {
+        if let Some(v) = get(key) {
+            spec.fixed.set_value(key, v);
+        }
+    }
+    // A free-decay row (it has ω0): the same model in identifiable terms.
+    if given(FitParam::Omega0) {
+        if given(FitParam::DryC) {
+            spec.params.push(FitParam::of("coulomb_constant"));
+        }
+        spec = spec
+            .free_decay()
+            .map_err(|e| bad(format!("model {name}: {e}")))?;
+    }
+    let params = spec
+        .params
+        .iter()
+        .map(|p| get(p.name()).ok_or_else(|| bad(format!("model {name}: no column {}", p.name()))))
+        .collect::<Result<Vec<f64>, _>>()?;
+    // A fit may have widened a search range past the catalogue's: its values hold.
+    for (&p, &v) in spec.params.clone().iter().zip(&params) {
+        spec.hold(p, v);
+    }
+    Ok(FitOutcome {
+        spec,
+        params,
+        f_obj: get("f_obj").unwrap_or(f64::NAN),
+        e_theta: get("e_theta").unwrap_or(f64::NAN),
+        generations: get("generations").unwrap_or(0.0) as u64,
+        evaluations: get("evaluations").unwrap_or(0.0) as u64,
+        abandoned: 0,
+        stop_reason: "given".into(),
+        wall_s: 0.0,
+        seed: get("seed").unwrap_or(0.0) as u64,
+        np: get("np").unwrap_or(0.0) as usize,
+        convergence: Vec::new(),
+        runs: Vec::new(),
+        polished: None,
+        alignments: Default::default(),
+    })
 }
 
 fn validation_of<'a>(ctx: &'a Context, model: &str) -> Option<&'a [RunFit]> {
@@ -1239,5 +1213,52 @@ mod tests {
             assert!(e.contains("refusing to write the plot"), "{e}");
             assert!(!e.contains('\u{1b}'), "{e:?}");
         }
+    }
+}
+
+#[cfg(test)]
+mod read_params_tests {
+    use super::*;
+
+    /// A params table saved again with 32-bit floats (pandas after `astype("float32")`, or a
+    /// tool that narrows) is the same model to `validate`: before the reader was shared with
+    /// `design`'s, such a table was refused ("model reference: no column a").
+    #[test]
+    fn a_table_with_32_bit_floats_is_the_same_model() {
+        use arrow_array::{ArrayRef, Float32Array, RecordBatch, StringArray};
+        use std::sync::Arc;
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("params.parquet");
+        let f32col = |v: f32| Arc::new(Float32Array::from(vec![v])) as ArrayRef;
+        let batch = RecordBatch::try_from_iter(vec![
+            (
+                "model",
+                Arc::new(StringArray::from(vec!["reference+coulomb_constant"])) as ArrayRef,
+            ),
+            ("a", f32col(0.05)),
+            ("b", f32col(0.5)),
+            ("mu", f32col(0.15)),
+            ("coulomb_constant.T_c", f32col(0.004)),
+        ])
+        .unwrap();
+        let mut w = parquet::arrow::ArrowWriter::try_new(
+            std::fs::File::create(&path).unwrap(),
+            batch.schema(),
+            None,
+        )
+        .unwrap();
+        w.write(&batch).unwrap();
+        w.close().unwrap();
+        let m = read_params(&path, None).unwrap();
+        let names: Vec<&str> = m.spec.params.iter().map(|p| p.name()).collect();
+        assert_eq!(names, ["a", "b", "mu", "coulomb_constant.T_c"]);
+        for (v, want) in m.params.iter().zip([0.05, 0.5, 0.15, 0.004]) {
+            assert!(
+                (v - want).abs() <= 1e-7 * want.max(1.0),
+                "{v} against {want}"
+            );
+        }
+        let err = read_params(&path, Some("linear")).unwrap_err().to_string();
+        assert!(err.contains("no model named \"linear\""), "{err}");
     }
 }
