@@ -1698,11 +1698,18 @@ fn a_lag_is_not_refused_by_trajectories_whose_run_is_zeroed_off_by_counts() {
 /// whole. Both named, the offset within 2 mrad and the inertia within 10 %.
 #[test]
 fn an_offset_beside_an_inertia_is_not_refused_by_a_view_its_runs_zeros_blind() {
-    let mut r = rng(3000 + 2 + 100_000);
+    offset_and_inertia_pair_is_named(100_000);
+}
+
+/// The every-effect survey's pair 2 (an encoder offset and an extra inertia, the study's
+/// damping) at seed offset `off`: both named and nothing else, the offset within 2 mrad and the
+/// inertia within 10 %.
+fn offset_and_inertia_pair_is_named(off: u64) {
+    let mut r = rng(3000 + 2 + off);
     let (t_off, s_off, ..) = draw("encoder_offset", &mut r);
     let (t_j, s_j, ..) = draw("extra_inertia", &mut r);
     let s = discover(
-        7000 + 2 + 100_000,
+        7000 + 2 + off,
         Base::Reference,
         0.0,
         0.5,
@@ -1717,10 +1724,10 @@ fn an_offset_beside_an_inertia_is_not_refused_by_a_view_its_runs_zeros_blind() {
         "{:#?}",
         s.discovery.rows
     );
-    let off = s.discovery.row("encoder_offset").unwrap().estimate;
+    let off_est = s.discovery.row("encoder_offset").unwrap().estimate;
     assert!(
-        (off - t_off).abs() <= 0.002,
-        "offset {off:.4e} against {t_off:.4e}"
+        (off_est - t_off).abs() <= 0.002,
+        "offset {off_est:.4e} against {t_off:.4e}"
     );
     let j = s.discovery.row("extra_inertia").unwrap().estimate;
     assert!(
@@ -2599,6 +2606,20 @@ fn draw_before_the_catalogue(
     }
 }
 
+/// The damping check of `s`, asserted to read `want`.
+fn damping_verdict(
+    s: &DiscoverSummary,
+    want: pendulum_discover::DampingVerdict,
+) -> &pendulum_discover::DampingCheck {
+    let check = s
+        .discovery
+        .damping_check
+        .as_ref()
+        .expect("free segments move");
+    assert_eq!(check.verdict(), want, "{check:#?}");
+    check
+}
+
 /// The nothing-hidden campaign `k` of the false-alarm survey with the drag drawn
 /// (`SURVEY_DAMPING=drawn`, seed offset `off`): its damping a, b, μ and its summary.
 fn false_alarm_campaign_with_drag(
@@ -2638,16 +2659,7 @@ fn free_swings_and_shaken_runs_that_lose_energy_differently_are_reported() {
     assert!(truth > 0.0);
     let dir = tempfile::tempdir().unwrap();
     let s = discover_in(dir.path(), 5300 + off, base, a, b, mu, &spec);
-    let check = s
-        .discovery
-        .damping_check
-        .as_ref()
-        .expect("free segments move");
-    assert_eq!(
-        check.verdict(),
-        pendulum_discover::DampingVerdict::Disagrees,
-        "{check:#?}"
-    );
+    let check = damping_verdict(&s, pendulum_discover::DampingVerdict::Disagrees);
     let (fb, fmu) = (check.free_params[1], check.free_params[2]);
     assert!(
         (fb - b).abs() <= 0.10 * b,
@@ -2673,16 +2685,7 @@ fn a_damping_split_the_shaken_runs_leave_open_is_pinned_by_the_free_swings() {
     let dir = tempfile::tempdir().unwrap();
     let ((_, b, mu), s) = false_alarm_campaign_with_drag(dir.path(), 900_000, 1);
     assert!(s.discovery.accepted().is_empty());
-    let check = s
-        .discovery
-        .damping_check
-        .as_ref()
-        .expect("free segments move");
-    assert_eq!(
-        check.verdict(),
-        pendulum_discover::DampingVerdict::NotPinned,
-        "{check:#?}"
-    );
+    let check = damping_verdict(&s, pendulum_discover::DampingVerdict::NotPinned);
     let err = |x: &[f64]| ((x[1] / b - 1.0).abs()).max((x[2] / mu - 1.0).abs());
     let (base_err, joint_err) = (err(&s.discovery.base.params), err(&check.joint_params));
     assert!(
@@ -2704,16 +2707,7 @@ fn a_damping_split_the_shaken_runs_leave_open_is_pinned_by_the_free_swings() {
 fn free_swings_that_agree_with_the_base_fit_add_nothing_to_the_report() {
     let dir = tempfile::tempdir().unwrap();
     let (_, s) = false_alarm_campaign_with_drag(dir.path(), 900_000, 2);
-    let check = s
-        .discovery
-        .damping_check
-        .as_ref()
-        .expect("free segments move");
-    assert_eq!(
-        check.verdict(),
-        pendulum_discover::DampingVerdict::Agrees,
-        "{check:#?}"
-    );
+    damping_verdict(&s, pendulum_discover::DampingVerdict::Agrees);
     let report = std::fs::read_to_string(&s.report).unwrap();
     assert!(!report.contains("lose energy differently"), "{report}");
     assert!(!report.contains("Damping not pinned"), "{report}");
@@ -2754,34 +2748,5 @@ fn a_breakaway_no_better_than_the_refused_constant_torque_it_becomes_is_not_name
 /// offset are, the offset within 2 mrad and the inertia within 10 %.
 #[test]
 fn a_position_torque_standing_in_for_an_offset_and_an_inertia_is_not_named() {
-    let off = 300_000;
-    let mut r = rng(3000 + 2 + off);
-    let (t_off, s_off, ..) = draw("encoder_offset", &mut r);
-    let (t_j, s_j, ..) = draw("extra_inertia", &mut r);
-    let s = discover(
-        7000 + 2 + off,
-        Base::Reference,
-        0.0,
-        0.5,
-        0.15,
-        &format!("{s_off}\n{s_j}"),
-    );
-    let mut accepted = s.discovery.accepted();
-    accepted.sort_unstable();
-    assert_eq!(
-        accepted,
-        ["encoder_offset", "extra_inertia"],
-        "{:#?}",
-        s.discovery.rows
-    );
-    let off_est = s.discovery.row("encoder_offset").unwrap().estimate;
-    assert!(
-        (off_est - t_off).abs() <= 0.002,
-        "offset {off_est:.4e} against {t_off:.4e}"
-    );
-    let j = s.discovery.row("extra_inertia").unwrap().estimate;
-    assert!(
-        (j - t_j).abs() <= 0.10 * t_j,
-        "inertia {j:.4e} against {t_j:.4e}"
-    );
+    offset_and_inertia_pair_is_named(300_000);
 }
