@@ -3116,11 +3116,20 @@ pub fn discover(
                         > SECOND_LOOK_GAIN_FACTOR * sp.heldout_noise.max(cfg.eq_gain_min)
             })
         };
+        // Beyond the rig's own tolerance by both views: where the trajectories tell a torque's
+        // or an inertia's size from its absence, their value too. An encoder's code disc
+        // mounted 0.0156 rad off centre (the departure survey's `encoder_eccentricity` k=3,
+        // `DEPARTURE_SEED=6`) reads as an inertia growing with each run's bob, averaged to
+        // 2.24e-4 kg·m² by the identify runs' screen (1.04 % of the lightest bob's m l², its
+        // tolerance 1 %) and to 1.31e-4 by their trajectories (0.6 %); it was named on the
+        // validate runs' equation error while their E_θ fell 8.0 % ± 10.2 %.
+        let significant = practically_significant(&c.effect, est, jitter_s, bob_inertia)
+            && !(torque_or_inertia
+                && size_power == Some(true)
+                && refit_est.is_finite()
+                && !practically_significant(&c.effect, refit_est, jitter_s, bob_inertia));
         // Everything but the agreement of the views (the pair look asks for that apart).
-        let plausible_but_agree = partial.is_none()
-            && !runs_disagree
-            && practically_significant(&c.effect, est, jitter_s, bob_inertia)
-            && possible;
+        let plausible_but_agree = partial.is_none() && !runs_disagree && significant && possible;
         let plausible = plausible_but_agree && agree;
         // With the base pinned (see [`PINNED_LOOK`]): does the candidate's refit take each base
         // parameter off the end of the search range that held it? (It may leave another at an
@@ -3603,7 +3612,7 @@ pub fn discover(
                     "; beside the first round's other candidates, the identify and the validate rows each put its size at under a tenth of this, their intervals excluding it: it stands in for them, not named"
                 } else if runs_disagree {
                     "; with it in, the runs still disagree on the size of the model's damping (each run's own factor takes more than twice the bar off the other blocks' equation error): a partial explanation of a departure that follows the run, not named"
-                } else if !practically_significant(&c.effect, est, jitter_s, bob_inertia) {
+                } else if !significant {
                     "; within the rig's own tolerance (encoder zeroing, the stamps' timing jitter, or the inertia the point-mass bob leaves out): not named"
                 } else if refit_pinned {
                     "; the trajectory refit stops at its search range's bound, its size's or its shape's (the bound, not the data, set it): not accepted"
