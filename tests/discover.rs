@@ -2674,6 +2674,12 @@ fn free_swings_and_shaken_runs_that_lose_energy_differently_are_reported() {
         report.contains("The free swings and the shaken runs lose energy differently"),
         "{report}"
     );
+    // The same in a table a dataframe user reads.
+    let table = dir.path().join("out").join("damping_check.parquet");
+    let free_b = crate::identify::column_f64(&table, "free.b");
+    assert_eq!(free_b, [fb], "{}", table.display());
+    let fall = crate::identify::column_f64(&table, "joint_fall_on_forced_from_base");
+    assert!(fall[0] < 0.0, "{fall:?}");
 }
 
 /// Campaign 1 of the false-alarm survey with the drag drawn at `SURVEY_SEED=9` (nothing hidden;

@@ -156,10 +156,11 @@ pub fn diagnosis_table(d: &Discovery) -> String {
 
 /// What `discover` writes besides identify's tables ([`crate::outputs::TABLES`]) and plots
 /// named after models and runs; checked against the inputs before any work.
-pub const OUTPUTS: [&str; 6] = [
+pub const OUTPUTS: [&str; 7] = [
     "diagnosis.parquet",
     "signatures.parquet",
     "envelopes.parquet",
+    "damping_check.parquet",
     "report.md",
     "signatures.png",
     "envelopes.png",
@@ -457,6 +458,43 @@ fn run_unmarked(job: &DiscoverJob) -> Result<DiscoverSummary, JobError> {
     )?;
     summary.tables.push(out.join("diagnosis.parquet"));
     summary.tables.push(out.join("signatures.parquet"));
+    // damping_check.parquet: the base fit's damping beside the free segments' and the joint one
+    // (one row; where any identify run's free segment moves).
+    if let Some(c) = &d.damping_check {
+        let spec = &d.base.spec;
+        let mut cols = vec![
+            Column::new(
+                "verdict",
+                ColumnData::Str(vec![match c.verdict() {
+                    pendulum_discover::DampingVerdict::Agrees => "agrees",
+                    pendulum_discover::DampingVerdict::NotPinned => "not_pinned",
+                    pendulum_discover::DampingVerdict::Disagrees => "disagrees",
+                }
+                .to_string()]),
+            ),
+            f(vec![c.n_segments as f64], "free_segments", "runs"),
+        ];
+        for (label, x) in [
+            ("base", &d.base.params),
+            ("free", &c.free_params),
+            ("joint", &c.joint_params),
+        ] {
+            for (p, v) in spec.params.iter().zip(x) {
+                cols.push(f(vec![*v], &format!("{label}.{}", p.name()), p.unit()));
+            }
+        }
+        let fall = "1 (fractional fall of E_θ over 0.5 s segments; negative: a rise)";
+        for (name, (g, n)) in [
+            ("free_fall_from_base", c.free_gain),
+            ("joint_fall_on_free_from_free", c.joint_on_free),
+            ("joint_fall_on_forced_from_base", c.joint_on_forced),
+        ] {
+            cols.push(f(vec![g], name, fall));
+            cols.push(f(vec![n], &format!("{name}_noise"), fall));
+        }
+        opts.write(&out.join("damping_check.parquet"), &cols)?;
+        summary.tables.push(out.join("damping_check.parquet"));
+    }
     let sig_png = out.join("signatures.png");
     signature_plot(&sig_png, &d)?;
     summary.plots.push(sig_png.clone());
