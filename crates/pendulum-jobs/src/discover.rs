@@ -1312,6 +1312,32 @@ fn write_report(
         let _ = writeln!(r, "\n**{}.** {}.", note.0, note.1);
     }
     let _ = writeln!(r, "\n## Diagnosis\n\nOne row per catalogue candidate screened (ΔBIC of the weak-form equation error on the identify runs); the best are refitted on the trajectories and accepted only if their 95 % interval excludes zero and the error on the validate runs, which neither the screen nor the refit saw, falls by more than chance explains: E_θ by more than max(2 %, its noise), or the equation error by more than max(5 %, its noise) while E_θ does not rise by more than its noise. Where the validate runs' equation error could see the candidate (the fall it would show were the candidate true at the screen's size clears its bar) but does not confirm it, E_θ's fall must be twice its bar, and any rise of that equation error refuses it; where it could not, it neither confirms nor contradicts. A fall's noise is 1.96 × its standard error from the paired differences of the validate runs' 0.5 s shooting segments (E_θ) or weak-form windows (equation error); `gain ± noise` and `eq gain` in the table. Two more conditions: the estimate is physically possible (no negative damping, dry torque or inertia), and the trajectory refit (`refit`) agrees with the screen's estimate, within its interval or 10 %, whichever is wider.\n\n```\n{table}```\n");
+    // Why each judged candidate was named or not: the table says only yes or no, and a reader
+    // who expected an effect must see which condition it failed (the same notes as
+    // `diagnosis.parquet`'s `note`; a candidate the screen passed over says only that).
+    let judged: Vec<&pendulum_discover::DiagnosisRow> = d
+        .rows
+        .iter()
+        .filter(|row| {
+            row.accepted || row.heldout_gain.is_finite() || row.heldout_eq_gain.is_finite()
+        })
+        .collect();
+    if !judged.is_empty() {
+        let _ = writeln!(
+            r,
+            "Why each candidate judged on the held-out runs was named or not:\n"
+        );
+        for row in judged {
+            let _ = writeln!(
+                r,
+                "- `{}`: {}. {}.",
+                row.effect,
+                if row.accepted { "named" } else { "not named" },
+                row.note.trim_end_matches('.')
+            );
+        }
+        let _ = writeln!(r);
+    }
     if !d.forcing_not_understood.is_empty() {
         let _ = writeln!(r, "**Forcing not understood.** The crank-rod model, with the crank phase tracked turn by turn, does not explain the accelerometer of these runs (residual over {} × the sensor's own noise, measured while the shaker was off); their forced segments were left out of the equation-error view and their crank fits out of the sensor and drive effects (`forcing_understood` in `runs.parquet`):\n", pendulum_process::align::FORCING_MISFIT_RATIO);
         for (id, res, noise) in &d.forcing_not_understood {
