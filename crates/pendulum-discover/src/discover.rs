@@ -119,8 +119,10 @@ pub struct DiagnosisRow {
     /// ([`views_agree`]).
     pub refit_estimate: f64,
     /// The identify runs' trajectories' own 95 % range for `refit_estimate`, where it is the
-    /// value named (a shaped effect, accepted: [`trajectory_range`]); NaN otherwise. A lower end
-    /// of 0 says the trajectories cannot tell the size from the effect's absence.
+    /// value named (a shaped effect, or one the second look named on its trajectories,
+    /// accepted: [`trajectory_range`]); NaN otherwise. A lower end of 0 says the trajectories
+    /// cannot tell the size from the effect's absence. Where the trajectories named it on the
+    /// second look, `ci_low`/`ci_high` are this range widened to hold `estimate`.
     #[serde(default = "nan")]
     pub refit_ci_low: f64,
     #[serde(default = "nan")]
@@ -3532,24 +3534,35 @@ pub fn discover(
         // screen was within 3.1 % and the refit within 3.0 %.)
         let shaped_by_trajectories = c.shaped().is_some() && refit_est.is_finite();
         let trajectories_value = second_look || shaped_by_trajectories;
+        // On the second look, where the trajectories tell the size from its absence and the
+        // model judged carries their value (not the screen's, `silent`, `lag_silent`), they are
+        // the view that named it, and its interval is theirs too. The screen's interval widened
+        // to hold their value said [−1.7, 4.2] N·m for a breakaway named at 1.2e-2 N·m on its
+        // trajectories (`SURVEY_DAMPING=drawn SURVEY_SEED=3`, `stribeck` k=4): a named effect
+        // whose own interval held its absence.
+        let named_by_trajectories =
+            second_look && informative && !(silent || lag_silent) && refit_est.is_finite();
         // Its named value's own interval, from the view that gave it.
         let refit_range = match size_index {
-            Some(i) if accepted && shaped_by_trajectories => Some(trajectory_range(
-                &traj_runs,
-                &spec,
-                &refit_x,
-                &traj_ics,
-                i,
-                run_zeros,
-                cfg.refit_evals,
-            )),
+            Some(i) if accepted && (shaped_by_trajectories || named_by_trajectories) => {
+                Some(trajectory_range(
+                    &traj_runs,
+                    &spec,
+                    &refit_x,
+                    &traj_ics,
+                    i,
+                    run_zeros,
+                    cfg.refit_evals,
+                ))
+            }
             _ => None,
         };
+        let named_band = refit_range.filter(|_| named_by_trajectories).unwrap_or(ci);
         // The equation-error estimate, so that the estimate and its interval come from the
         // same regression; the trajectory refit's value is in the note and params.parquet.
         // On the second look the trajectories are the view that sees the effect (and for a
-        // shaped effect, above, the value the held-out runs judged): their value, inside the
-        // screen's interval widened to hold it.
+        // shaped effect, above, the value the held-out runs judged): their value, inside their own
+        // range where they named it (`named_band`), else the screen's interval widened to hold it.
         let identify_value = if trajectories_value { refit_est } else { est };
         // Named: the validate runs have judged it, and its value is then estimated on every
         // run by the same view (`pooled_screen_estimate`, `pooled_refit`): model choice on
@@ -3579,8 +3592,11 @@ pub fn discover(
         .filter(|(v, _)| v.is_finite() && physically_possible(&c.effect, *v));
         let (value, (ci_low, ci_high)) = match pooled {
             Some((v, se)) if se.is_finite() => (v, (v - 1.96 * se, v + 1.96 * se)),
-            Some((v, _)) => (v, (ci.0.min(v), ci.1.max(v))),
-            None if trajectories_value => (refit_est, (ci.0.min(refit_est), ci.1.max(refit_est))),
+            Some((v, _)) => (v, (named_band.0.min(v), named_band.1.max(v))),
+            None if trajectories_value => (
+                refit_est,
+                (named_band.0.min(refit_est), named_band.1.max(refit_est)),
+            ),
             None => (est, ci),
         };
         let row = DiagnosisRow {
