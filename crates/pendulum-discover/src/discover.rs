@@ -684,6 +684,18 @@ fn per_run_mean(values: &[f64], nominal: f64) -> (f64, f64, f64) {
     (mean, half, delta_bic)
 }
 
+/// The identify runs' direct reading of an offset of the angle's reading: each run's free decay
+/// swings about the offset plus that run's own zeroing error (a few counts, rig.md), so the 95 %
+/// interval of their mean from the runs' scatter ([`per_run_mean`]). `None` with fewer than
+/// three readings (`hanging_position`: a free decay with swings to read).
+fn hanging_interval(readings: &[f64]) -> Option<(f64, f64)> {
+    if readings.len() < 3 {
+        return None;
+    }
+    let (mean, half, _) = per_run_mean(readings, 0.0);
+    Some((mean - half, mean + half))
+}
+
 /// A named sensor effect's value from every run's reading, identify (`id`) and validate (`val`):
 /// their mean less the `nominal` value, its interval from their scatter (as [`per_run_mean`]),
 /// once the validate runs have judged it (as a torque's is estimated on every run: see
@@ -2385,6 +2397,14 @@ pub fn discover(
             message: "no base fit: the pipeline needs a fit stage before discover".into(),
         })?;
     let mut id_runs = ctx.prepared(Role::Identify, &cfg.validate.window, "discover")?;
+    // Where each identify run's free decay hangs, as the encoder reads it (for an offset of the
+    // reading, [`pendulum_model::Effect::reads_hanging_position`]).
+    let hanging_id: Vec<f64> = ctx
+        .runs
+        .iter()
+        .filter(|r| r.role == Role::Identify)
+        .filter_map(|r| ctx.hanging.get(&r.id).copied().flatten())
+        .collect();
     let mut val_runs = ctx.prepared(Role::Validate, &cfg.validate.window, "discover")?;
     if !ctx.runs.iter().any(|r| r.role == Role::Identify) {
         return Err(ProcessError::BadConfig {
@@ -2930,6 +2950,22 @@ pub fn discover(
         if let Some((lo, hi)) = c.size_band.filter(|_| !nonlinear) {
             ci = (ci.0.min(lo), ci.1.max(hi));
         }
+        // An offset of the angle's reading is also read directly: each identify run's free
+        // decay swings about it plus that run's own zeroing error ([`hanging_interval`]). Where
+        // the screen's column, read through the runs' zero contrasts and the damping, holds the
+        // size only loosely, and the free decays' centres tell it from 0 and hold the screen's
+        // value, the two views agree and the centres' interval is the size's. A hidden
+        // 5.68e-2 rad offset on a drawn design (`SURVEY_DAMPING=drawn SURVEY_SEED=4`,
+        // `encoder_offset` k=4; three of five identify runs resting under the shaker) was
+        // screened at 5.68e-2 [−4.8e-2, 0.162] (ΔBIC −22.2), refitted at 5.86e-2, and took
+        // 94.3 % ± 26.2 % off the validate runs' E_θ, while every run's free decay swung about
+        // +0.055 to +0.064 rad; it was not named ("interval includes 0").
+        let hanging_reads = effect.reads_hanging_position()
+            && !(ci.0 > 0.0 || ci.1 < 0.0)
+            && hanging_interval(&hanging_id)
+                .filter(|h| (h.0 > 0.0 || h.1 < 0.0) && h.0 <= est && est <= h.1)
+                .map(|h| ci = h)
+                .is_some();
         let excludes_zero = ci.0 > 0.0 || ci.1 < 0.0;
         // Either held-out measure will do. On the equation error alone, E_θ may not rise by more than its own noise: near the
         // study's setting the validate runs' segments scatter by ±10–20 %, more than a dry torque
@@ -3632,6 +3668,8 @@ pub fn discover(
                     "second look (the model holding the first named effect was pinned at its search range; judged on the held-out runs and on whether the candidate's refit frees it)"
                 } else if second_look {
                     "second look (the identify runs' equation error cannot see it; judged on the held-out runs)"
+                } else if hanging_reads {
+                    "interval excludes 0 (the free decays' centres, which hold the screen's value: the screen's own interval held 0)"
                 } else if excludes_zero {
                     "interval excludes 0"
                 } else {
@@ -4421,6 +4459,26 @@ mod tests {
         assert!(sizes_disagree(-3.75e-3, 0.93e-3, -1.80e-2, 2.87e-3));
         assert!(sizes_disagree(1.80e-2, 0.93e-3, 3.75e-3, 2.87e-3));
     }
+    /// The free decays' centres as a reading of an offset: the drawn seed-4 campaign's five
+    /// identify runs (+0.0621 … +0.0620 rad) hold their mean, 0.0596, within Student's t over
+    /// their scatter (t 2.776 for 4 degrees of freedom: ± 0.0040) and tell it from 0; zeroing
+    /// errors of a few counts either side of 0 do not; two readings are not enough to say.
+    #[test]
+    fn free_decay_centres_read_an_offset_within_their_scatter() {
+        let seed4 = [0.0621, 0.0553, 0.0568, 0.0616, 0.0620];
+        let (lo, hi) = hanging_interval(&seed4).unwrap();
+        let mean = seed4.iter().sum::<f64>() / 5.0;
+        let sd = (seed4.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / 4.0).sqrt();
+        let half = 2.776 * sd / 5f64.sqrt();
+        assert!((lo - (mean - half)).abs() < 1e-4 && (hi - (mean + half)).abs() < 1e-4);
+        assert!(lo > 0.0);
+        let count = 2.0 * std::f64::consts::PI / 4096.0;
+        let zeros = [2.0 * count, -3.0 * count, count, -count, 0.0];
+        let (lo, hi) = hanging_interval(&zeros).unwrap();
+        assert!(lo < 0.0 && hi > 0.0, "[{lo}, {hi}]");
+        assert!(hanging_interval(&seed4[..2]).is_none());
+    }
+
     /// A named sensor effect's value from every run's reading, by hand: the mean of identify
     /// and validate readings less the nominal, its interval Student's t over their scatter;
     /// a row not named, or one without validate readings, keeps the identify runs' value.

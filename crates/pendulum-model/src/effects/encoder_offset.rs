@@ -33,6 +33,10 @@ impl Effect for EncoderOffset {
     fn tolerance(&self) -> Option<Tolerance> {
         Some(Tolerance::EncoderCounts(4.0))
     }
+    /// Each run's free decay swings about θ_off plus that run's own zeroing error.
+    fn reads_hanging_position(&self) -> bool {
+        true
+    }
     /// Within half a turn: an offset beyond it is another zero, not an offset.
     fn possible(&self, size: f64) -> bool {
         size.abs() < std::f64::consts::PI

@@ -411,6 +411,14 @@ pub trait Effect: Sync + std::fmt::Debug {
         None
     }
 
+    /// Whether its size is read directly by where each run's free decay hangs (the centre of its
+    /// swings: the hanging position as the encoder reports it). Only a shift of the reading
+    /// itself is: a torque that moves the equilibrium shifts it by its size over each run's
+    /// m g l, which differs from bob to bob. Default: no.
+    fn reads_hanging_position(&self) -> bool {
+        false
+    }
+
     /// The variables its torque follows when its regressor is a function of them alone (so that
     /// discover's generic library can describe the same departure in them with a freer shape);
     /// empty for effects coupled to the forcing or the sensors. Default: θ̇ for a shaped torque.
