@@ -696,6 +696,23 @@ fn hanging_interval(readings: &[f64]) -> Option<(f64, f64)> {
     Some((mean - half, mean + half))
 }
 
+/// How far apart two sets of runs, of `n_a` and `n_b` runs, may put an offset of the angle's
+/// reading by their own zeroing errors alone (95 %): each set's value of the offset is the offset
+/// plus the (weighted) mean of its runs' zeros, which the zeroing contrasts hold to a zero sum
+/// within the set ([`crate::weak::add_zero_error_contrasts`]), so the screen's intervals leave
+/// it out. The runs' zero scatter is read from where the identify runs' free decays hang
+/// (`readings`, each the offset plus that run's zero: their scatter also holds how well a centre
+/// is read, so this errs wide); 0 with fewer than three readings.
+fn zeroing_half(readings: &[f64], n_a: usize, n_b: usize) -> f64 {
+    let n = readings.len();
+    if n < 3 || n_a == 0 || n_b == 0 {
+        return 0.0;
+    }
+    let mean = readings.iter().sum::<f64>() / n as f64;
+    let sd = (readings.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1) as f64).sqrt();
+    t95(n - 1) * sd * (1.0 / n_a as f64 + 1.0 / n_b as f64).sqrt()
+}
+
 /// A named sensor effect's value from every run's reading, identify (`id`) and validate (`val`):
 /// their mean less the `nominal` value, its interval from their scatter (as [`per_run_mean`]),
 /// once the validate runs have judged it (as a torque's is estimated on every run: see
@@ -3349,8 +3366,20 @@ pub fn discover(
         } else {
             None
         };
-        let size_disagrees =
-            heldout_size.is_some_and(|((e, s), (v, sv))| sizes_disagree(e, 1.96 * s, v, 1.96 * sv));
+        // For an offset of the angle's reading, each set's value also holds the mean of its
+        // runs' zeroing errors ([`zeroing_half`]). A hidden 2.82e-2 rad offset beside a
+        // 1.40e-2 kg·m² inertia on a drawn design (`SURVEY_DAMPING=drawn SURVEY_SEED=4`, the
+        // every-effect survey's pair 2) was put at 2.76e-2 [2.50e-2, 3.02e-2] by the identify rows
+        // (their zeros −1, 0, 2, −1, −2 counts) and 3.23e-2 [3.14e-2, 3.33e-2] by the validate
+        // rows (−1, 2, 2 counts), and refused as one size not describing both.
+        let zeroing = if effect.reads_hanging_position() {
+            let count = |role: Role| ctx.runs.iter().filter(|r| r.role == role).count();
+            zeroing_half(&hanging_id, count(Role::Identify), count(Role::Validate))
+        } else {
+            0.0
+        };
+        let size_disagrees = heldout_size
+            .is_some_and(|((e, s), (v, sv))| sizes_disagree(e, 1.96 * s + zeroing, v, 1.96 * sv));
         // A stand-in: a k = 1 position torque of 0.41 N·m on a drawn design whose rig hid a
         // 0.0365 rad encoder offset and a 0.0129 kg·m² inertia (the every-effect survey's pair 2,
         // `SURVEY_DAMPING=drawn SURVEY_SEED=3`) was named while the inertia was held back and
@@ -4458,6 +4487,33 @@ mod tests {
         // Symmetric in the sign of the difference, and in the sign of the size.
         assert!(sizes_disagree(-3.75e-3, 0.93e-3, -1.80e-2, 2.87e-3));
         assert!(sizes_disagree(1.80e-2, 0.93e-3, 3.75e-3, 2.87e-3));
+    }
+    /// Two sets' values of an offset hold the means of their own runs' zeroing errors: read from
+    /// the scatter of where the free decays hang (the drawn seed-4 pair's five identify runs), the
+    /// 2.76e-2 against 3.23e-2 rad of its identify and validate rows (five and three runs) is
+    /// within what the zeros alone put between them, and without it the two disagree. No scatter,
+    /// or fewer than three readings, widens nothing.
+    #[test]
+    fn two_sets_of_runs_read_an_offset_apart_by_their_zeros_mean() {
+        let centres = [0.0281, 0.0325, 0.0334, 0.0280, 0.0292];
+        let z = zeroing_half(&centres, 5, 3);
+        let mean = centres.iter().sum::<f64>() / 5.0;
+        let sd = (centres.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / 4.0).sqrt();
+        assert!(
+            (z - 2.776 * sd * (1.0f64 / 5.0 + 1.0 / 3.0).sqrt()).abs() < 1e-5,
+            "{z}"
+        );
+        assert!(sizes_disagree(2.7592e-2, 2.612e-3, 3.2325e-2, 0.947e-3));
+        assert!(!sizes_disagree(
+            2.7592e-2,
+            2.612e-3 + z,
+            3.2325e-2,
+            0.947e-3
+        ));
+        assert_eq!(zeroing_half(&[0.03; 5], 5, 3), 0.0);
+        assert_eq!(zeroing_half(&centres[..2], 5, 3), 0.0);
+        // More runs on either side, less room.
+        assert!(zeroing_half(&centres, 20, 20) < z);
     }
     /// The free decays' centres as a reading of an offset: the drawn seed-4 campaign's five
     /// identify runs (+0.0621 … +0.0620 rad) hold their mean, 0.0596, within Student's t over
