@@ -704,13 +704,12 @@ fn hanging_interval(readings: &[f64]) -> Option<(f64, f64)> {
 /// (`readings`, each the offset plus that run's zero: their scatter also holds how well a centre
 /// is read, so this errs wide); 0 with fewer than three readings.
 fn zeroing_half(readings: &[f64], n_a: usize, n_b: usize) -> f64 {
-    let n = readings.len();
-    if n < 3 || n_a == 0 || n_b == 0 {
+    if readings.len() < 3 || n_a == 0 || n_b == 0 {
         return 0.0;
     }
-    let mean = readings.iter().sum::<f64>() / n as f64;
-    let sd = (readings.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1) as f64).sqrt();
-    t95(n - 1) * sd * (1.0 / n_a as f64 + 1.0 / n_b as f64).sqrt()
+    // The mean's half-width, t95 · s / √n, back to one reading's: t95 · s.
+    let (_, half, _) = per_run_mean(readings, 0.0);
+    half * (readings.len() as f64).sqrt() * (1.0 / n_a as f64 + 1.0 / n_b as f64).sqrt()
 }
 
 /// A named sensor effect's value from every run's reading, identify (`id`) and validate (`val`):
