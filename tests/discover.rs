@@ -1712,6 +1712,51 @@ fn an_offset_whose_two_sets_of_runs_differ_by_their_zeros_is_named() {
     offset_and_inertia_pair_is_named(400_000);
 }
 
+/// The every-effect survey's pair 4 at `SURVEY_SEED=5` (pairs do not draw their damping): a
+/// 2.97e-2 rad tilted guide beside a 1.02e-2 N·m constant dry torque, on a design whose identify
+/// runs but one rest under the shaker, swinging a few counts to tens at its frequency. The
+/// equation error leaves those stretches out (dry friction may hold the pendulum there), so the
+/// tilt's column was empty on its 56 windows and the row said "not estimable … neither found nor
+/// ruled out". The accelerometer's horizontal axis reads it on every forced run (its slope on the
+/// vertical one is tan δ); the trajectories, whose forced swings it drives, must agree with that
+/// value and the validate runs' E_θ fall with it. Both named and nothing else, the tilt within
+/// 10 % and read by the accelerometer. (The dry torque's size is not asserted: it is named at the
+/// screen's 1.29e-2, +26 %, its refit at −4.4 %; README, misses.)
+#[test]
+fn a_tilt_the_resting_pendulum_hides_from_the_equation_error_is_read_by_the_accelerometer() {
+    let mut r = rng(3000 + 3 + 500_000);
+    let (_, s_c, ..) = draw("coulomb_constant", &mut r);
+    let (t_d, s_d, ..) = draw("horizontal_base", &mut r);
+    let s = discover(
+        7000 + 3 + 500_000,
+        Base::Reference,
+        0.0,
+        0.5,
+        0.15,
+        &format!("{s_c}\n{s_d}"),
+    );
+    let mut accepted = s.discovery.accepted();
+    accepted.sort_unstable();
+    assert_eq!(
+        accepted,
+        ["coulomb_constant", "horizontal_base"],
+        "{:#?}",
+        s.discovery.rows
+    );
+    let row = s.discovery.row("horizontal_base").unwrap();
+    assert!(
+        (row.estimate - t_d).abs() <= 0.10 * t_d.abs(),
+        "tilt {:.4e} against {t_d:.4e}",
+        row.estimate
+    );
+    assert!(
+        row.note
+            .contains("the accelerometer's horizontal axis reads it directly"),
+        "{}",
+        row.note
+    );
+}
+
 /// The every-effect survey's pair 2 (an encoder offset and an extra inertia, the study's
 /// damping) at seed offset `off`: both named and nothing else, the offset within 2 mrad and the
 /// inertia within 10 %.

@@ -40,6 +40,11 @@ impl Effect for HorizontalBase {
     fn params(&self) -> &'static [Param] {
         &PARAMS
     }
+    /// The axis moves x = y·tan δ: the accelerometer's x axis reads tan δ times its z axis's
+    /// motion.
+    fn reads_horizontal_slope(&self) -> bool {
+        true
+    }
     fn what(&self) -> &'static str {
         "the shaker's guide is tilted δ from vertical in the pendulum's plane: x = y·tan δ"
     }

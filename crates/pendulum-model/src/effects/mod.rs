@@ -419,6 +419,14 @@ pub trait Effect: Sync + std::fmt::Debug {
         false
     }
 
+    /// Whether the accelerometer's x axis reads its size directly: the slope of the horizontal
+    /// acceleration on the vertical one over a forced run is the tangent of the size, whether
+    /// the pendulum moves or not (rig.md: x horizontal in the pendulum's plane, fixed to the
+    /// worktable). Only a tilt of the guide's motion itself is. Default: no.
+    fn reads_horizontal_slope(&self) -> bool {
+        false
+    }
+
     /// The variables its torque follows when its regressor is a function of them alone (so that
     /// discover's generic library can describe the same departure in them with a freer shape);
     /// empty for effects coupled to the forcing or the sensors. Default: θ̇ for a shaped torque.
