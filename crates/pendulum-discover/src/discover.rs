@@ -4850,6 +4850,40 @@ mod tests {
     /// identify runs (+0.0621 … +0.0620 rad) hold their mean, 0.0596, within Student's t over
     /// their scatter (t 2.776 for 4 degrees of freedom: ± 0.0040) and tell it from 0; zeroing
     /// errors of a few counts either side of 0 do not; two readings are not enough to say.
+    /// A tilted guide's forced run as the accelerometer sees it: the horizontal axis is tan δ
+    /// times the vertical one's motion, each axis with its own zero-g offset and noise, and a
+    /// glitch to full scale on the horizontal axis every 2 s (at the crest of the motion, where
+    /// it tilts a line most). The slope reads tan δ within the noise; the plain line, glitches
+    /// in, does not; an axis that does not move says nothing.
+    #[test]
+    fn the_horizontal_axis_reads_a_tilt_as_its_slope_on_the_vertical_one() {
+        let tan_d = 0.03;
+        // Deterministic noise, uniform in (−0.5, 0.5).
+        let noise = |i: usize, k: f64| ((i as f64 * 12.9898 + k).sin() * 43_758.545).fract() - 0.5;
+        let pts: Vec<(f64, f64)> = (0..4000)
+            .map(|i| {
+                let t = i as f64 * 0.005;
+                let y = 8.0 * (2.0 * std::f64::consts::PI * 1.5 * t).sin();
+                let z = 9.806_65 + 0.3 + y + 0.04 * noise(i, 1.0);
+                let crest = i % 400 == 33;
+                let x = if crest {
+                    30.0
+                } else {
+                    -0.2 + tan_d * y + 0.04 * noise(i, 2.0)
+                };
+                (z, x)
+            })
+            .collect();
+        let b = robust_slope(&pts, SLOPE_MIN_Z_RMS_M_S2).unwrap();
+        assert!((b - tan_d).abs() < 2e-4, "{b}");
+        let (plain, _) = line_fit(&pts, SLOPE_MIN_Z_RMS_M_S2).unwrap();
+        assert!((plain - tan_d).abs() > 5e-3, "{plain}");
+        let still: Vec<(f64, f64)> = (0..4000)
+            .map(|i| (9.8 + 0.04 * noise(i, 1.0), 0.04 * noise(i, 2.0)))
+            .collect();
+        assert!(robust_slope(&still, SLOPE_MIN_Z_RMS_M_S2).is_none());
+    }
+
     #[test]
     fn free_decay_centres_read_an_offset_within_their_scatter() {
         let seed4 = [0.0621, 0.0553, 0.0568, 0.0616, 0.0620];
