@@ -527,6 +527,7 @@ fn departures_outside_their_range_are_refused_by_key() {
             "encoder_eccentricity_rad",
         ),
         ("dry_torque_lobes_nm = -0.01", "dry_torque_lobes_nm"),
+        ("axis_sway_ratio = 0.7", "axis_sway_ratio"),
         (
             "dry_torque_lobes_nm = 0.01\ndry_torque_lobes_k = 0",
             "dry_torque_lobes_k",
@@ -565,7 +566,7 @@ type DrawDeparture = fn(&mut rand_chacha::ChaCha8Rng) -> String;
 /// The survey's departures, each with how its size is drawn: wider than the regression tests
 /// above (springs from barely felt to stiff, encoders mislabelled on either side of their
 /// header, plays, growths and run spreads from small to large).
-const DEPARTURES: [(&str, DrawDeparture); 10] = [
+const DEPARTURES: [(&str, DrawDeparture); 11] = [
     ("torsion_spring", |r| {
         let k = (r.random_range(0.02f64.ln()..0.3f64.ln())).exp();
         format!("torsion_spring_nm_per_rad = {k}")
@@ -619,6 +620,12 @@ const DEPARTURES: [(&str, DrawDeparture); 10] = [
         format!(
             "dry_torque_lobes_k = {k}\ndry_torque_lobes_phase_rad = {phi}\ndry_torque_lobes_nm = {t}"
         )
+    }),
+    ("axis_sway", |r| {
+        // A bearing bracket swaying with the table as a tilted guide of 0.02–0.08 rad would move
+        // the axis (the catalogue's own tilt draws), either side, unseen by the accelerometer.
+        let s = r.random_range(0.02..0.08) * if r.random_bool(0.5) { 1.0 } else { -1.0 };
+        format!("axis_sway_ratio = {s}")
     }),
 ];
 
@@ -718,6 +725,36 @@ fn described_within(name: &str, k: u64, variable: Variable, term: &str, rel: f64
 /// a k = 2 position torque beside it. A shape no freer than the candidate's that fits clearly
 /// better makes the candidate the wrong shape: `unexplained`, following the unwrapped θ, a
 /// spring, its k within 10 %.
+/// A bearing bracket that sways with the table (the axis moves x = s·y relative to the worktable,
+/// the departure survey's `axis_sway` draw 0): the pendulum feels it exactly as a tilted guide,
+/// so the screen fits `horizontal_base` at about atan s, and before the accelerometer's reading
+/// was asked every check of the pendulum's own views agreed. But effects.md's tilt moves the
+/// worktable, which the accelerometer's x axis sees; here it reads no tilt. Nothing may be
+/// named, `unexplained` must be said, and the tilt's row must say what the accelerometer read.
+#[test]
+fn a_swaying_bracket_is_not_named_a_tilt_the_accelerometer_does_not_see() {
+    let (seed, b, mu, departure) = drawn_departure("axis_sway", 0, 0);
+    let s = discover_with(seed, b, mu, &departure);
+    let d = &s.discovery;
+    assert!(
+        d.accepted().is_empty(),
+        "named {:?} for a swaying bracket ({departure}): {:#?}",
+        d.accepted(),
+        d.rows
+    );
+    let words = d
+        .unexplained
+        .as_deref()
+        .unwrap_or_else(|| panic!("no `unexplained` for {departure}: {:#?}", d.rows));
+    let tilt = d.row("horizontal_base").expect("a tilt row");
+    assert!(
+        tilt.note.contains("the accelerometer's horizontal axis")
+            && words.contains("the guide is not tilted so"),
+        "{}\n{words}",
+        tilt.note
+    );
+}
+
 #[test]
 fn a_weak_torsion_spring_is_not_named_a_position_torque() {
     let words = described_within("torsion_spring", 2, Variable::Angle, "θ", 0.1);

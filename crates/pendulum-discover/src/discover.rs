@@ -897,6 +897,17 @@ fn horizontal_slopes(ctx: &Context, role: Role) -> Vec<f64> {
         .collect()
 }
 
+/// A tilt read from forced runs' horizontal slopes ([`horizontal_slopes`], each tan δ): δ, the
+/// half-width of its 95 % interval from their scatter ([`per_run_mean`]), and ΔBIC against no
+/// tilt; `None` with fewer than three runs.
+fn tilt_reading(slopes: &[f64]) -> Option<(f64, f64, f64)> {
+    if slopes.len() < 3 {
+        return None;
+    }
+    let (m, h, delta_bic) = per_run_mean(slopes, 0.0);
+    Some((m.atan(), 0.5 * ((m + h).atan() - (m - h).atan()), delta_bic))
+}
+
 /// Discover's state that the accelerometer's reading of a tilted guide is judged against (see
 /// [`TiltJudge::judge`]): the model in hand and the runs it was judged on.
 struct TiltJudge<'a> {
@@ -945,13 +956,12 @@ impl TiltJudge<'_> {
     ) -> Result<Option<TiltFound>, ProcessError> {
         let (cfg, current) = (self.cfg, self.current);
         let id = horizontal_slopes(self.ctx, Role::Identify);
-        if id.len() < 3 {
+        let Some((est, half, delta_bic)) = tilt_reading(&id) else {
             return Ok(None);
-        }
+        };
         let val = horizontal_slopes(self.ctx, Role::Validate);
-        let (mean, half, delta_bic) = per_run_mean(&id, 0.0);
-        let est = mean.atan();
-        let (lo, hi) = ((mean - half).atan(), (mean + half).atan());
+        let mean = est.tan();
+        let (lo, hi) = (est - half, est + half);
         let reads = (lo > 0.0 || hi < 0.0) && delta_bic < cfg.screen_threshold;
         let read_words = format!(
             "the equation error could not estimate it (its {n_windows} windows on the identify runs leave out the forced stretches where dry friction may hold the pendulum, and there it swings a few counts under the shaker); the accelerometer's horizontal axis reads it directly, its slope on the vertical axis tan δ on {} forced identify runs: δ = {est:.4e} [{lo:.4e}, {hi:.4e}] rad (ΔBIC {delta_bic:.1})",
@@ -1095,12 +1105,11 @@ impl TiltJudge<'_> {
         }
         // Named: sized on every run's reading, identify and validate, as a sensor effect is
         // ([`pool_readings`]).
-        if !val.is_empty() {
-            let all: Vec<f64> = id.iter().chain(&val).copied().collect();
-            let (m, h, _) = per_run_mean(&all, 0.0);
-            row.estimate = m.atan();
-            row.ci_low = (m - h).atan();
-            row.ci_high = (m + h).atan();
+        let all: Vec<f64> = id.iter().chain(&val).copied().collect();
+        if let Some((d, h, _)) = tilt_reading(&all).filter(|_| !val.is_empty()) {
+            row.estimate = d;
+            row.ci_low = d - h;
+            row.ci_high = d + h;
             row.note.push_str(&format!(
                 "; estimated on every run's reading (identify and validate) once the validate runs had judged it: {:.4e} rad (the identify runs alone: {est:.4e})",
                 row.estimate
@@ -3684,7 +3693,18 @@ pub fn discover(
             && heldout_size.is_some_and(|((e, s), (v, sv))| {
                 stands_in_for_others(est, (e, 1.96 * s), (v, 1.96 * sv))
             });
-        let accepted = accepted && !size_disagrees && !stand_in;
+        // A tilted guide is also read by the accelerometer's horizontal axis, whether the
+        // pendulum moves or not ([`TiltJudge`]); where it reads another tilt than the screen's,
+        // the torque the screen took for one is something else (a departure in the forcing's
+        // phase and cos θ, say), and the sensor, not the pendulum, says where the guide points.
+        let accel_tilt = effect
+            .reads_horizontal_slope()
+            .then(|| tilt_reading(&horizontal_slopes(ctx, Role::Identify)))
+            .flatten();
+        let accel_disagrees =
+            accel_tilt.is_some_and(|(d, h, _)| sizes_disagree(est, 1.96 * se, d, h));
+        let accel_refuses = accepted && !size_disagrees && !stand_in && accel_disagrees;
+        let accepted = accepted && !size_disagrees && !stand_in && !accel_disagrees;
         // The pair look's second candidate, judged beside the first one held provisionally:
         // the first must not do better refitted away in the model holding both (its E_θ gain
         // beside the second, and the gain's noise).
@@ -3880,6 +3900,19 @@ pub fn discover(
                 c.effect, sc.delta_bic, ci.0, ci.1,
             ));
         }
+        // A tilt the accelerometer denies is a departure the catalogue does not name.
+        if let Some((d, h, _)) = accel_tilt.filter(|_| screen_route && accel_refuses) {
+            refused = Some(format!(
+                "the best catalogue candidate, {} (ΔBIC {:.1}), fits the departure as a tilt of \
+                 {est:.4e} rad, but the accelerometer's horizontal axis reads δ = {d:.4e} \
+                 [{:.4e}, {:.4e}] rad: the guide is not tilted so, and the departure is \
+                 something else",
+                c.effect,
+                sc.delta_bic,
+                d - h,
+                d + h,
+            ));
+        }
         // A shaped effect's screened size holds only at the shape the screen's blind profile
         // chose; its refit chooses the shape again ([`shape_start`]), and only the refit's model
         // is judged on the validate runs (E_θ). So the value named is the refit's, whether or not
@@ -4006,6 +4039,8 @@ pub fn discover(
                     "; the validate runs' own rows put its size elsewhere (one size does not describe the departure on the runs the fit never saw): a partial explanation, not named"
                 } else if stand_in {
                     "; beside the first round's other candidates, the identify and the validate rows each put its size at under a tenth of this, their intervals excluding it: it stands in for them, not named"
+                } else if accel_refuses {
+                    "; the accelerometer's horizontal axis does not move as this tilt would (its reading below): the guide is not tilted so, and the departure is something else, not named"
                 } else if runs_disagree {
                     "; with it in, the runs still disagree on the size of the model's damping (each run's own factor takes more than twice the bar off the other blocks' equation error): a partial explanation of a departure that follows the run, not named"
                 } else if !significant {
@@ -4033,6 +4068,13 @@ pub fn discover(
             ),
         };
         let mut row = row;
+        if let Some((d, h, _)) = accel_tilt {
+            row.note.push_str(&format!(
+                "; the accelerometer's horizontal axis (its slope on the vertical one, tan δ, on each forced identify run) reads δ = {d:.4e} [{:.4e}, {:.4e}] rad",
+                d - h,
+                d + h
+            ));
+        }
         if held_back {
             let still: Vec<&str> = still_pinned.iter().map(|p| p.name()).collect();
             row.note.push_str(&format!(

@@ -140,6 +140,12 @@ pub struct Departures {
     /// Where it drags most, φ, rad (default 0; with `dry_torque_lobes_nm`).
     #[serde(default)]
     pub dry_torque_lobes_phase_rad: Option<f64>,
+    /// The pendulum's bearing bracket sways in the pendulum's plane as the table shakes (a
+    /// compliant mount): its axis moves x = s·y relative to the worktable, this s. The pendulum
+    /// feels it as a tilted guide would, but the accelerometer, fixed to the worktable, does not
+    /// see it (effects.md's `horizontal_base` is a tilt the accelerometer's x axis sees).
+    #[serde(default)]
+    pub axis_sway_ratio: Option<f64>,
 }
 
 impl Departures {
@@ -222,6 +228,9 @@ impl Departures {
                 "encoder_eccentricity_phase_rad",
                 "a phase beside an encoder_eccentricity_rad (alone it has no disc to misplace)",
             ));
+        }
+        if bad(self.axis_sway_ratio, |v| v.abs() < 0.5) {
+            return Some(("axis_sway_ratio", "a finite sway ratio within ±0.5"));
         }
         if bad(self.dry_torque_lobes_nm, |v| v >= 0.0) {
             return Some((
@@ -724,6 +733,9 @@ fn synthesize_run(
             .dry_torque_lobes_phase_rad
             .unwrap_or(0.0);
     }
+    // A swaying bracket moves the axis as a tilt would, unseen by the accelerometer (below).
+    let sway = case.truth.departures.axis_sway_ratio.unwrap_or(0.0);
+    d.tan_delta += sway;
     let w0 = phys.omega0_rad_s();
     // Dimensionless time of the shaker start and of being at speed.
     let t_start = run.free_s * w0;
@@ -929,6 +941,8 @@ fn synthesize_run(
     let mut acc_raw = Vec::with_capacity(t_acc.len());
     for &t in &t_acc {
         let (ay, ax) = model.excitation.accel(sensors.accel_shows_s(t) * w0);
+        // The worktable's own horizontal motion: a swaying bracket's is not the table's.
+        let ax = ax - sway * ay;
         let truth_g = [ax, 0.0, 1.0 + ay];
         let mut raw = [0i16; 3];
         for k in 0..3 {
