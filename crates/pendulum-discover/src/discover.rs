@@ -967,25 +967,14 @@ impl TiltJudge<'_> {
             "the equation error could not estimate it (its {n_windows} windows on the identify runs leave out the forced stretches where dry friction may hold the pendulum, and there it swings a few counts under the shaker); the accelerometer's horizontal axis reads it directly, its slope on the vertical axis tan δ on {} forced identify runs: δ = {est:.4e} [{lo:.4e}, {hi:.4e}] rad (ΔBIC {delta_bic:.1})",
             id.len()
         );
+        // (The screen has no value of it: `screen_estimate` stays NaN.)
         let mut row = DiagnosisRow {
-            effect: effect.name().into(),
-            accepted: false,
             estimate: est,
             identify_estimate: est,
             ci_low: lo,
             ci_high: hi,
-            unit: unit.into(),
             delta_bic,
-            heldout_gain: f64::NAN,
-            heldout_noise: f64::NAN,
-            heldout_eq_gain: f64::NAN,
-            screen_estimate: f64::NAN,
-            refit_estimate: f64::NAN,
-            refit_ci_low: f64::NAN,
-            refit_ci_high: f64::NAN,
-            e_validate_before: f64::NAN,
-            e_validate_after: f64::NAN,
-            note: String::new(),
+            ..DiagnosisRow::words_only(effect.name(), unit, String::new())
         };
         if !reads {
             row.note = format!("{read_words}: no tilt beyond that interval; not named");
