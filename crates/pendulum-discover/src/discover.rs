@@ -831,6 +831,9 @@ fn accel_gain_row(ctx: &Context, cfg: &DiscoverConfig) -> Option<DiagnosisRow> {
 /// clipped, and its slope is not the axis's.
 const ACCEL_CLIP_M_S2: f64 = 0.99 * 4.0 * 9.806_65;
 
+/// One LSB of the accelerometer (±4 g at 8192 LSB/g, rig.md), m/s².
+const ACCEL_LSB_M_S2: f64 = 9.806_65 / 8192.0;
+
 /// Robust spreads (1.4826 × the median absolute residual) beyond which an accelerometer sample
 /// is taken for a glitch in a slope fit.
 const SLOPE_GLITCH_SIGMAS: f64 = 5.0;
@@ -854,13 +857,15 @@ fn line_fit(pts: &[(f64, f64)], min_z_rms: f64) -> Option<(f64, f64)> {
 }
 
 /// The slope of `x` on `z` with glitches left out: a first line, then again without the points
-/// beyond [`SLOPE_GLITCH_SIGMAS`] robust spreads of its residual.
+/// beyond [`SLOPE_GLITCH_SIGMAS`] robust spreads of its residual. `None` where `x` spreads about
+/// the line by under half an LSB: a live MPU-6050 axis reads tens of LSB of noise, and one that
+/// never changes is not connected (its slope of 0 would deny every tilt).
 fn robust_slope(pts: &[(f64, f64)], min_z_rms: f64) -> Option<f64> {
     let (b, c) = line_fit(pts, min_z_rms)?;
     let mut r: Vec<f64> = pts.iter().map(|(z, x)| (x - c - b * z).abs()).collect();
     let s = 1.4826 * pendulum_numerics::median(&mut r);
-    if !(s > 0.0) {
-        return Some(b);
+    if !(s >= 0.5 * ACCEL_LSB_M_S2) {
+        return None;
     }
     let kept: Vec<(f64, f64)> = pts
         .iter()
@@ -4950,7 +4955,7 @@ mod tests {
     /// times the vertical one's motion, each axis with its own zero-g offset and noise, and a
     /// glitch to full scale on the horizontal axis every 2 s (at the crest of the motion, where
     /// it tilts a line most). The slope reads tan δ within the noise; the plain line, glitches
-    /// in, does not; an axis that does not move says nothing.
+    /// in, does not; a vertical axis that does not move, or a horizontal one that never changes, says nothing.
     #[test]
     fn the_horizontal_axis_reads_a_tilt_as_its_slope_on_the_vertical_one() {
         let tan_d = 0.03;
@@ -4978,6 +4983,9 @@ mod tests {
             .map(|i| (9.8 + 0.04 * noise(i, 1.0), 0.04 * noise(i, 2.0)))
             .collect();
         assert!(robust_slope(&still, SLOPE_MIN_Z_RMS_M_S2).is_none());
+        // Nor does a horizontal axis that never changes (not connected).
+        let dead: Vec<(f64, f64)> = pts.iter().map(|&(z, _)| (z, -0.2)).collect();
+        assert!(robust_slope(&dead, SLOPE_MIN_Z_RMS_M_S2).is_none());
     }
 
     #[test]
