@@ -443,7 +443,7 @@ impl Default for WeakConfig {
 
 /// One encoder count (rig.md: 4096 per revolution), rad: only the scale of the widening below,
 /// so a capture whose header gives other counts per revolution is not read differently.
-const ENCODER_COUNT_RAD: f64 = std::f64::consts::TAU / 4096.0;
+pub(crate) const ENCODER_COUNT_RAD: f64 = std::f64::consts::TAU / 4096.0;
 
 /// Weights giving the slope b1 (per unit x) of the least-squares cubic through 2h + 1 equally
 /// spaced samples at x_j = (j − h)/h, j = 0..=2h (see where it is used).
