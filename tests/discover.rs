@@ -1696,8 +1696,9 @@ fn a_lag_is_not_refused_by_trajectories_whose_run_is_zeroed_off_by_counts() {
 /// E_θ cannot see a lag (the refitted model with it set to 0 scores the same), and the other
 /// terms' trade moved it from 8.7e-5 to 3.3e-2 rad summed over every sample, a fraction of an
 /// encoder count, which as a ratio is a rise of 37 855 % ± 18 229 %, past twice its noise: it was
-/// refused as "plainly worse on the runs the fit never saw". A trade under half an encoder step
-/// per sample is one the encoder cannot see. Named within the score's 0.5 ms.
+/// refused as "plainly worse on the runs the fit never saw". A trade under a quarter of an encoder
+/// step per sample (1.1e-5 rad here; reading an angle as whole counts errs by a quarter step on
+/// average) is one the encoder cannot see. Named within the score's 0.5 ms.
 #[test]
 fn a_lag_whose_trade_moves_resting_runs_by_a_fraction_of_a_count_is_named() {
     let (truth, s) = run_as_surveyed_with_damping("accel_delay", 601_903, 609_903, 605_903);
