@@ -243,9 +243,10 @@ fn regression_issue_12_growing_dry_torque_is_unexplained() {
 /// candidate, a negative accelerometer lag (−1.25e-3 s [−1.44e-3, −1.05e-3], ΔBIC −111.8,
 /// refit −1.07e-3 s: the measured angle lags the shaft, which reads as an accelerometer that
 /// leads), with no variable named: neither the generic description nor the binned variables
-/// single out dθ/dt on the shorter free segments.
+/// single out dθ/dt on the shorter free segments. It passes again on 0550d28's build and on
+/// c72164d (checked in the forty-fourth session), so it is in the slow set.
 #[test]
-#[ignore = "known failure since b5a5bf7: nothing named, but case 0's unexplained words name no variable (its best candidate is a negative accel_delay); see the doc comment"]
+#[ignore = "slow set (two drawn backlashes; a known failure from b5a5bf7, passing again on 0550d28's build and on c72164d, checked in the forty-fourth session): the default suite checks a backlash on an_encoder_backlash_is_not_named_an_accelerometer_lead; README, Tests"]
 fn encoder_backlash_is_unexplained_and_follows_the_rate() {
     let mut r = rng(4);
     for case in 0..2 {
