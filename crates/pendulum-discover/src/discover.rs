@@ -927,8 +927,6 @@ fn tilt_reading(slopes: &[f64]) -> Option<(f64, f64, f64)> {
 struct TiltJudge<'a> {
     ctx: &'a Context,
     cfg: &'a DiscoverConfig,
-    current: &'a FitOutcome,
-    current_val: &'a [RunFit],
     /// The model in hand's initial states of the identify runs (two per run).
     ics: &'a [f64],
     id_runs: &'a [PreparedRun],
@@ -964,13 +962,16 @@ impl TiltJudge<'_> {
     /// identify runs resting under the shaker, `SURVEY_DAMPING=drawn SURVEY_SEED=5`, pair 4) was
     /// "not estimable on the identify runs' 56 equation-error windows", while each forced run's
     /// accelerometer read tan δ = 0.0297 to 0.0298 and its pendulum swung ±5 to ±20 counts.
+    /// `current` is the model in hand and `current_val` its validation on the held-out runs.
     fn judge(
         &self,
+        current: &FitOutcome,
+        current_val: &[RunFit],
         effect: &'static dyn pendulum_model::effects::Effect,
         unit: &str,
         n_windows: usize,
     ) -> Result<Option<TiltFound>, ProcessError> {
-        let (cfg, current) = (self.cfg, self.current);
+        let cfg = self.cfg;
         let id = horizontal_slopes(self.ctx, Role::Identify);
         let Some((est, half, delta_bic)) = tilt_reading(&id) else {
             return Ok(None);
@@ -1055,7 +1056,7 @@ impl TiltJudge<'_> {
         start[i] = 0.0;
         let xa = refit_profile(&tz, &spec, &start, &tics, evals, i);
         let v_absent = validate(self.held_runs, &spec, &xa, &cfg.validate)?;
-        let (before_judged, before) = [self.current_val, &v_refit[..], &v_absent[..]]
+        let (before_judged, before) = [current_val, &v_refit[..], &v_absent[..]]
             .into_iter()
             .map(|v| {
                 let judged = judged_for(effect, v, self.free_moving_val);
@@ -2880,6 +2881,15 @@ pub fn discover(
     // 2.97e-2 rad tilt beside a 1.02e-2 N·m dry torque) named the dry torque at +26 % on every
     // run's rows while the tilt, judged after it, was left out of them.
     let mut tilt_first: Option<DiagnosisRow> = None;
+    let tilt_judge = TiltJudge {
+        ctx,
+        cfg,
+        ics: &ics,
+        id_runs: &id_runs,
+        free_moving: &free_moving,
+        held_runs: &held_runs,
+        free_moving_val: &free_moving_val,
+    };
     let tilt_candidate = crate::screen::candidates(base).into_iter().find_map(|c| {
         let e =
             pendulum_model::effects::by_name(&c.effect).filter(|e| e.reads_horizontal_slope())?;
@@ -2889,18 +2899,7 @@ pub fn discover(
         .filter(|(c, _)| !first_round.iter().any(|sc| sc.candidate.effect == c.effect))
     {
         let unit = effect.params().first().map_or("1", |p| p.unit);
-        let judge = TiltJudge {
-            ctx,
-            cfg,
-            current: &current,
-            current_val: &current_val,
-            ics: &ics,
-            id_runs: &id_runs,
-            free_moving: &free_moving,
-            held_runs: &held_runs,
-            free_moving_val: &free_moving_val,
-        };
-        let found = judge.judge(effect, unit, view0.id_rows.len())?;
+        let found = tilt_judge.judge(&current, &current_val, effect, unit, view0.id_rows.len())?;
         if let Some((row, (spec, x, val))) = found.and_then(|f| f.model.map(|m| (f.row, m))) {
             let at = effect
                 .size_key()
@@ -4582,18 +4581,9 @@ pub fn discover(
         if let Some(effect) =
             pendulum_model::effects::by_name(&c.effect).filter(|e| e.reads_horizontal_slope())
         {
-            let judge = TiltJudge {
-                ctx,
-                cfg,
-                current: &current,
-                current_val: &current_val,
-                ics: &ics,
-                id_runs: &id_runs,
-                free_moving: &free_moving,
-                held_runs: &held_runs,
-                free_moving_val: &free_moving_val,
-            };
-            if let Some(found) = judge.judge(effect, unit, view0.id_rows.len())? {
+            if let Some(found) =
+                tilt_judge.judge(&current, &current_val, effect, unit, view0.id_rows.len())?
+            {
                 if let Some((spec, x, val)) = found.model {
                     current = taken(&current, &id_runs, spec, x, &ics);
                     current_val = val;
