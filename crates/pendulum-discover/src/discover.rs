@@ -925,7 +925,6 @@ fn tilt_reading(slopes: &[f64]) -> Option<(f64, f64, f64)> {
 /// Discover's state that the accelerometer's reading of a tilted guide is judged against (see
 /// [`TiltJudge::judge`]): the model in hand and the runs it was judged on.
 struct TiltJudge<'a> {
-    ctx: &'a Context,
     cfg: &'a DiscoverConfig,
     /// The model in hand's initial states of the identify runs (two per run).
     ics: &'a [f64],
@@ -933,6 +932,10 @@ struct TiltJudge<'a> {
     free_moving: &'a [PreparedRun],
     held_runs: &'a [PreparedRun],
     free_moving_val: &'a [PreparedRun],
+    /// The identify and the validate runs' horizontal slopes ([`horizontal_slopes`]): the
+    /// captures do not change during the search, so they are read once.
+    id_slopes: Vec<f64>,
+    val_slopes: Vec<f64>,
 }
 
 /// A tilt the accelerometer read: its row, and the model that holds it when it is named (spec,
@@ -972,11 +975,10 @@ impl TiltJudge<'_> {
         n_windows: usize,
     ) -> Result<Option<TiltFound>, ProcessError> {
         let cfg = self.cfg;
-        let id = horizontal_slopes(self.ctx, Role::Identify);
-        let Some((est, half, delta_bic)) = tilt_reading(&id) else {
+        let (id, val) = (&self.id_slopes, &self.val_slopes);
+        let Some((est, half, delta_bic)) = tilt_reading(id) else {
             return Ok(None);
         };
-        let val = horizontal_slopes(self.ctx, Role::Validate);
         let mean = est.tan();
         let (lo, hi) = (est - half, est + half);
         let reads = (lo > 0.0 || hi < 0.0) && delta_bic < cfg.screen_threshold;
@@ -1072,7 +1074,7 @@ impl TiltJudge<'_> {
         row.heldout_noise = noise;
         row.e_validate_before = before;
         row.e_validate_after = e_total(&after_judged);
-        let (s_gain, s_before, s_after) = sensor_heldout(&val, 0.0, mean);
+        let (s_gain, s_before, s_after) = sensor_heldout(val, 0.0, mean);
         let sensor_confirms = val.is_empty() || s_gain > SENSOR_HELDOUT_GAIN;
         row.accepted =
             informative && agree && gain > gain_needed && sensor_confirms && effect.possible(est);
@@ -1114,7 +1116,7 @@ impl TiltJudge<'_> {
         }
         // Named: sized on every run's reading, identify and validate, as a sensor effect is
         // ([`pool_readings`]).
-        let all: Vec<f64> = id.iter().chain(&val).copied().collect();
+        let all: Vec<f64> = id.iter().chain(val).copied().collect();
         if let Some((d, h, _)) = tilt_reading(&all).filter(|_| !val.is_empty()) {
             row.estimate = d;
             row.ci_low = d - h;
@@ -2882,13 +2884,14 @@ pub fn discover(
     // run's rows while the tilt, judged after it, was left out of them.
     let mut tilt_first: Option<DiagnosisRow> = None;
     let tilt_judge = TiltJudge {
-        ctx,
         cfg,
         ics: &ics,
         id_runs: &id_runs,
         free_moving: &free_moving,
         held_runs: &held_runs,
         free_moving_val: &free_moving_val,
+        id_slopes: horizontal_slopes(ctx, Role::Identify),
+        val_slopes: horizontal_slopes(ctx, Role::Validate),
     };
     let tilt_candidate = crate::screen::candidates(base).into_iter().find_map(|c| {
         let e =
@@ -3798,7 +3801,7 @@ pub fn discover(
         // phase and cos θ, say), and the sensor, not the pendulum, says where the guide points.
         let accel_tilt = effect
             .reads_horizontal_slope()
-            .then(|| tilt_reading(&horizontal_slopes(ctx, Role::Identify)))
+            .then(|| tilt_reading(&tilt_judge.id_slopes))
             .flatten();
         let accel_disagrees =
             accel_tilt.is_some_and(|(d, h, _)| sizes_disagree(est, 1.96 * se, d, h));
