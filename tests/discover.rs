@@ -965,6 +965,14 @@ fn a_generator_whose_forced_identify_runs_all_rest_is_refitted_on_their_free_seg
         row.refit_ci_low,
         row.refit_ci_high
     );
+    // The value named is theirs, so is its interval: their range widened to hold it.
+    assert!(
+        row.ci_low == row.refit_ci_low.min(row.estimate)
+            && row.ci_high == row.refit_ci_high.max(row.estimate),
+        "named interval [{:.4e}, {:.4e}]",
+        row.ci_low,
+        row.ci_high
+    );
     assert!(
         s.text.contains("free segment before the shaker starts"),
         "the report says the free segments joined the refits:\n{}",
@@ -1821,6 +1829,34 @@ fn offset_and_inertia_pair_is_named(off: u64) {
     assert!(
         (j - t_j).abs() <= 0.10 * t_j,
         "inertia {j:.4e} against {t_j:.4e}"
+    );
+}
+
+/// A 6.31e-3 N·m breakaway fading at 0.245 rad/s on a drawn design whose identify runs all rest
+/// under their shaking (`SURVEY_DAMPING=drawn SURVEY_SEED=6`, `stribeck` k=1), screened on the
+/// screen's route and named at its trajectories' value, 8.34e-3 N·m (+32 %: their profile is
+/// flat, the truth's own held-out fall the same 23.7 %). Its interval was the screen's at the
+/// screen's shape widened to hold that value, [7.28e-3, 3.80e-2], leaving out the truth that the
+/// trajectories' own range [1.97e-3, 1.18e-2] held. The interval named is now the view's that
+/// gave the value: it holds the truth (the size itself is documented as not met, README).
+#[test]
+#[ignore = "slow set (a survey draw: `stribeck` k=1 at SURVEY_DAMPING=drawn SURVEY_SEED=6): the default suite checks that a shaped effect named on its trajectories reads their interval on a_generator_whose_forced_identify_runs_all_rest_is_refitted_on_their_free_segments; README, Tests"]
+fn a_breakaway_named_at_its_trajectories_value_reads_their_interval() {
+    let (truth, s) = run_as_surveyed_with_damping("stribeck", 602_201, 610_201, 606_201);
+    assert_eq!(s.discovery.accepted(), vec!["stribeck"]);
+    let row = s.discovery.row("stribeck").unwrap();
+    assert!(
+        row.ci_low == row.refit_ci_low.min(row.estimate)
+            && row.ci_high == row.refit_ci_high.max(row.estimate)
+            && row.ci_low <= truth
+            && truth <= row.ci_high
+            && row.ci_low > 0.0,
+        "named {:.4e} in [{:.4e}, {:.4e}]; trajectories [{:.4e}, {:.4e}]; truth {truth:.4e}",
+        row.estimate,
+        row.ci_low,
+        row.ci_high,
+        row.refit_ci_low,
+        row.refit_ci_high
     );
 }
 

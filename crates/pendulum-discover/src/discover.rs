@@ -121,8 +121,9 @@ pub struct DiagnosisRow {
     /// The identify runs' trajectories' own 95 % range for `refit_estimate`, where it is the
     /// value named (a shaped effect, or one the second look named on its trajectories,
     /// accepted: [`trajectory_range`]); NaN otherwise. A lower end of 0 says the trajectories
-    /// cannot tell the size from the effect's absence. Where the trajectories named it on the
-    /// second look, `ci_low`/`ci_high` are this range widened to hold `estimate`.
+    /// cannot tell the size from the effect's absence. Where the trajectories named it (on the
+    /// second look, or a shaped effect whose size they tell from its absence),
+    /// `ci_low`/`ci_high` are this range widened to hold `estimate`.
     #[serde(default = "nan")]
     pub refit_ci_low: f64,
     #[serde(default = "nan")]
@@ -4051,7 +4052,17 @@ pub fn discover(
             }
             _ => None,
         };
-        let named_band = refit_range.filter(|_| named_by_trajectories).unwrap_or(ci);
+        // So is a shaped effect's whose size the trajectories tell from its absence, whichever
+        // route named it: its value is theirs (above), and the screen's interval is at the
+        // screen's shape, not the value's. A breakaway named at 8.34e-3 N·m on its
+        // trajectories (v_s 0.24 rad/s) read the screen's [7.28e-3, 3.80e-2] widened to hold
+        // it, which left out the truth (6.31e-3) that its trajectories' own [1.97e-3, 1.18e-2]
+        // held (`SURVEY_DAMPING=drawn SURVEY_SEED=6`, `stribeck` k=1).
+        let shaped_named_by_trajectories =
+            shaped_by_trajectories && informative && !(silent || lag_silent);
+        let named_band = refit_range
+            .filter(|_| named_by_trajectories || shaped_named_by_trajectories)
+            .unwrap_or(ci);
         // The equation-error estimate, so that the estimate and its interval come from the
         // same regression; the trajectory refit's value is in the note and params.parquet.
         // On the second look the trajectories are the view that sees the effect (and for a
