@@ -590,6 +590,19 @@ pub fn stands_in_for_others(named: f64, identify: (f64, f64), heldout: (f64, f64
     named.is_finite() && named != 0.0 && far(identify) && far(heldout)
 }
 
+/// The catalogue's refit range of `effect`'s size where the interval `[lo, hi]` is wider than
+/// that whole range: the screen's column hardly moves on the identify runs' windows, and its
+/// value says nothing. A 7.9 ms accelerometer lag on a drawn design whose identify runs all
+/// rest under their shakers (`SURVEY_DAMPING=drawn SURVEY_SEED=7`, `accel_delay` k=2) was
+/// screened at −1.0 s [−1.85, −0.15], twenty times its range [−0.05, 0.05], and its row said
+/// "screened out" as if the runs had ruled it out.
+fn wider_than_its_range(effect: &str, lo: f64, hi: f64) -> Option<(f64, f64)> {
+    let e = pendulum_model::effects::by_name(effect)?;
+    let key = e.size_key()?;
+    let (a, b) = e.params().iter().find(|p| p.key == key)?.fit_range?;
+    (hi - lo > b - a).then_some((a, b))
+}
+
 /// Whether the screen (equation error) and the trajectory refit (output error) agree on an
 /// effect: the same sign, and each estimate inside the other's interval. The refit's value is
 /// inside the screen's when it lies within the screen's 95 % interval or within
@@ -4551,7 +4564,16 @@ pub fn discover(
         refit_ci_high: f64::NAN,
             e_validate_before: f64::NAN,
             e_validate_after: f64::NAN,
-            note: if sc.candidate.effect == "position_torque" {
+            note: if let Some((a, b)) = wider_than_its_range(&sc.candidate.effect, lo.min(est - 1.96 * se), hi.max(est + 1.96 * se)) {
+                format!(
+                    "{}not estimable on the identify runs: the screen's 95 % interval is wider than the effect's whole range [{a:.4e}, {b:.4e}] {unit} (its column hardly moves on their windows: too few where the pendulum moves under the shaker); neither found nor ruled out",
+                    if sc.candidate.effect == "position_torque" {
+                        format!("k = {}; ", sc.candidate.k)
+                    } else {
+                        String::new()
+                    }
+                )
+            } else if sc.candidate.effect == "position_torque" {
                 format!("k = {}; screened out", sc.candidate.k)
             } else if sc.candidate.add.iter().all(|c| screened.nuisance.contains(c)) {
                 "within the rig's zeroing tolerance (under 4 counts): kept as a nuisance term, not named".into()
@@ -4977,10 +4999,27 @@ mod tests {
         // More runs on either side, less room.
         assert!(zeroing_half(&centres, 20, 20) < z);
     }
-    /// The free decays' centres as a reading of an offset: the drawn seed-4 campaign's five
-    /// identify runs (+0.0621 … +0.0620 rad) hold their mean, 0.0596, within Student's t over
-    /// their scatter (t 2.776 for 4 degrees of freedom: ± 0.0040) and tell it from 0; zeroing
-    /// errors of a few counts either side of 0 do not; two readings are not enough to say.
+
+    #[test]
+    fn an_interval_wider_than_the_effects_whole_range_estimates_nothing() {
+        // The drawn case's lag: −1.0 s [−1.85, −0.15] against [−0.05, 0.05].
+        assert_eq!(
+            wider_than_its_range("accel_delay", -1.85, -0.15),
+            Some((-0.05, 0.05))
+        );
+        // A loose but informative interval is an estimate.
+        assert_eq!(wider_than_its_range("accel_delay", 5.7e-3, 1.57e-2), None);
+        assert_eq!(
+            wider_than_its_range("stribeck", -0.72, 0.83),
+            Some((0.0, 0.05))
+        );
+        // A switch has no size of its own to range.
+        assert_eq!(
+            wider_than_its_range("bearing_load_base_accel", -9.0, 9.0),
+            None
+        );
+    }
+
     /// A tilted guide's forced run as the accelerometer sees it: the horizontal axis is tan δ
     /// times the vertical one's motion, each axis with its own zero-g offset and noise, and a
     /// glitch to full scale on the horizontal axis every 2 s (at the crest of the motion, where
@@ -5018,6 +5057,10 @@ mod tests {
         assert!(robust_slope(&dead, SLOPE_MIN_Z_RMS_M_S2).is_none());
     }
 
+    /// The free decays' centres as a reading of an offset: the drawn seed-4 campaign's five
+    /// identify runs (+0.0621 … +0.0620 rad) hold their mean, 0.0596, within Student's t over
+    /// their scatter (t 2.776 for 4 degrees of freedom: ± 0.0040) and tell it from 0; zeroing
+    /// errors of a few counts either side of 0 do not; two readings are not enough to say.
     #[test]
     fn free_decay_centres_read_an_offset_within_their_scatter() {
         let seed4 = [0.0621, 0.0553, 0.0568, 0.0616, 0.0620];
