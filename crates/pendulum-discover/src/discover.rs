@@ -4546,13 +4546,14 @@ pub fn discover(
             .candidate
             .size_band
             .unwrap_or((est - 1.96 * se, est + 1.96 * se));
+        let (ci_low, ci_high) = (lo.min(est - 1.96 * se), hi.max(est + 1.96 * se));
         rows.push(DiagnosisRow {
             effect: sc.candidate.effect.clone(),
             accepted: false,
             estimate: est,
             identify_estimate: est,
-            ci_low: lo.min(est - 1.96 * se),
-            ci_high: hi.max(est + 1.96 * se),
+            ci_low,
+            ci_high,
             unit: unit.into(),
             delta_bic: sc.delta_bic,
             heldout_gain: f64::NAN,
@@ -4564,7 +4565,7 @@ pub fn discover(
         refit_ci_high: f64::NAN,
             e_validate_before: f64::NAN,
             e_validate_after: f64::NAN,
-            note: if let Some((a, b)) = wider_than_its_range(&sc.candidate.effect, lo.min(est - 1.96 * se), hi.max(est + 1.96 * se)) {
+            note: if let Some((a, b)) = wider_than_its_range(&sc.candidate.effect, ci_low, ci_high) {
                 format!(
                     "{}not estimable on the identify runs: the screen's 95 % interval is wider than the effect's whole range [{a:.4e}, {b:.4e}] {unit} (its column hardly moves on their windows: too few where the pendulum moves under the shaker); neither found nor ruled out",
                     if sc.candidate.effect == "position_torque" {
@@ -5000,6 +5001,8 @@ mod tests {
         assert!(zeroing_half(&centres, 20, 20) < z);
     }
 
+    /// A screened interval wider than the effect's whole refit range says nothing of its size;
+    /// a loose one inside it does.
     #[test]
     fn an_interval_wider_than_the_effects_whole_range_estimates_nothing() {
         // The drawn case's lag: −1.0 s [−1.85, −0.15] against [−0.05, 0.05].
