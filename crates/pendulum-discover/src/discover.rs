@@ -4071,8 +4071,15 @@ pub fn discover(
         // trajectories (v_s 0.24 rad/s) read the screen's [7.28e-3, 3.80e-2] widened to hold
         // it, which left out the truth (6.31e-3) that its trajectories' own [1.97e-3, 1.18e-2]
         // held (`SURVEY_DAMPING=drawn SURVEY_SEED=6`, `stribeck` k=1).
-        let shaped_named_by_trajectories =
-            shaped_by_trajectories && informative && !(silent || lag_silent);
+        // Only where their range itself leaves out 0: the refit with the size set to 0 and the
+        // rest held (`informative`) may fit worse while the profile, the rest refitted along
+        // it, reaches 0 (a 1.09e-2 N·m breakaway whose trajectories held it within [0, 1.50e-2]
+        // would have been named with an interval holding its own absence), and there the
+        // screen's interval, which excludes 0, stays.
+        let shaped_named_by_trajectories = shaped_by_trajectories
+            && informative
+            && !(silent || lag_silent)
+            && refit_range.is_some_and(|(lo, _)| lo > 0.0);
         let named_band = refit_range
             .filter(|_| named_by_trajectories || shaped_named_by_trajectories)
             .unwrap_or(ci);
