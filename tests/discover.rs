@@ -1925,6 +1925,33 @@ fn a_lag_the_resting_identify_runs_size_loosely_is_sized_on_every_run_once_named
     assert!(row.note.contains("estimated on every run"), "{}", row.note);
 }
 
+/// The same 7.92 ms lag with the rig's damping drawn too (`SURVEY_DAMPING=drawn SURVEY_SEED=7`,
+/// `accel_delay` k=2): heavier drag (b 0.667 N·s/m) stills the five identify runs' transients
+/// under their shakers sooner, and the lag's column hardly moves on their windows. The screen put
+/// it at −1.0 s [−1.85, −0.15], twenty times the effect's whole range, and the row said "screened
+/// out" as if the runs had ruled it out. Nothing is named, and the row and the report's table say
+/// the lag is not estimable on these runs, with no number standing for its size.
+#[test]
+fn a_lag_the_resting_identify_runs_cannot_estimate_is_not_ruled_out() {
+    let (_, s) = run_as_surveyed_with_damping("accel_delay", 701_902, 709_902, 705_902);
+    assert!(s.discovery.accepted().is_empty(), "{}", s.text);
+    let row = s.discovery.row("accel_delay").unwrap();
+    assert!(
+        row.estimate.is_nan()
+            && row.ci_low.is_nan()
+            && row.screen_estimate.is_finite()
+            && row.note.contains("not estimable on the identify runs")
+            && row.note.contains("neither found nor ruled out"),
+        "{row:#?}"
+    );
+    assert!(
+        s.text
+            .contains("accel_delay: not estimable on the identify runs"),
+        "{}",
+        s.text
+    );
+}
+
 /// A 0.0369 rad encoder offset on a drawn design (the every-effect survey's `encoder_offset`
 /// k=2, `SURVEY_SEED=7`), named at 0.0384 (+4.3 %): each run's count zeroed a few counts off
 /// moves the runs' mean zero about a count from the offset itself, and the regression's interval

@@ -4554,11 +4554,18 @@ pub fn discover(
             .size_band
             .unwrap_or((est - 1.96 * se, est + 1.96 * se));
         let (ci_low, ci_high) = (lo.min(est - 1.96 * se), hi.max(est + 1.96 * se));
+        // Not estimable: no estimate or interval, as for a column the screen could not separate
+        // at all (`screen_estimate` keeps the number).
+        let range = wider_than_its_range(&sc.candidate.effect, ci_low, ci_high);
+        let (value, ci_low, ci_high) = match range {
+            Some(_) => (f64::NAN, f64::NAN, f64::NAN),
+            None => (est, ci_low, ci_high),
+        };
         rows.push(DiagnosisRow {
             effect: sc.candidate.effect.clone(),
             accepted: false,
-            estimate: est,
-            identify_estimate: est,
+            estimate: value,
+            identify_estimate: value,
             ci_low,
             ci_high,
             unit: unit.into(),
@@ -4572,14 +4579,16 @@ pub fn discover(
         refit_ci_high: f64::NAN,
             e_validate_before: f64::NAN,
             e_validate_after: f64::NAN,
-            note: if let Some((a, b)) = wider_than_its_range(&sc.candidate.effect, ci_low, ci_high) {
+            note: if let Some((a, b)) = range {
                 format!(
-                    "{}not estimable on the identify runs: the screen's 95 % interval is wider than the effect's whole range [{a:.4e}, {b:.4e}] {unit} (its column hardly moves on their windows: too few where the pendulum moves under the shaker); neither found nor ruled out",
+                    "{}not estimable on the identify runs: the screen's 95 % interval, [{:.4e}, {:.4e}] {unit} about {est:.4e}, is wider than the effect's whole range [{a:.4e}, {b:.4e}] (its column hardly moves on their windows: too few where the pendulum moves under the shaker); neither found nor ruled out",
                     if sc.candidate.effect == "position_torque" {
                         format!("k = {}; ", sc.candidate.k)
                     } else {
                         String::new()
-                    }
+                    },
+                    lo.min(est - 1.96 * se),
+                    hi.max(est + 1.96 * se),
                 )
             } else if sc.candidate.effect == "position_torque" {
                 format!("k = {}; screened out", sc.candidate.k)

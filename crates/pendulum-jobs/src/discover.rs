@@ -132,8 +132,17 @@ pub fn diagnosis_table(d: &Discovery) -> String {
             pct(r.heldout_eq_gain)
         );
     }
-    // A value named from the trajectories, with their own range (the screen's interval above
-    // is the other view's).
+    // What the rows without a number say (a candidate the identify runs cannot estimate): "NaN"
+    // alone would read as a failure of the tool, not of the runs' design.
+    for r in d
+        .rows
+        .iter()
+        .filter(|r| !r.accepted && r.estimate.is_nan() && r.effect != "unexplained")
+    {
+        let _ = writeln!(t, "{}: {}", r.effect, r.note);
+    }
+    // A value named from the trajectories, with their own range (the interval above is the
+    // screen's, or theirs where they tell it from its absence).
     for r in d.rows.iter().filter(|r| r.refit_ci_low.is_finite()) {
         let _ = writeln!(
             t,
