@@ -4553,13 +4553,13 @@ pub fn discover(
             .candidate
             .size_band
             .unwrap_or((est - 1.96 * se, est + 1.96 * se));
-        let (ci_low, ci_high) = (lo.min(est - 1.96 * se), hi.max(est + 1.96 * se));
+        let band = (lo.min(est - 1.96 * se), hi.max(est + 1.96 * se));
         // Not estimable: no estimate or interval, as for a column the screen could not separate
-        // at all (`screen_estimate` keeps the number).
-        let range = wider_than_its_range(&sc.candidate.effect, ci_low, ci_high);
-        let (value, ci_low, ci_high) = match range {
-            Some(_) => (f64::NAN, f64::NAN, f64::NAN),
-            None => (est, ci_low, ci_high),
+        // at all (`screen_estimate` keeps the number, the note the interval).
+        let range = wider_than_its_range(&sc.candidate.effect, band.0, band.1);
+        let (value, (ci_low, ci_high)) = match range {
+            Some(_) => (f64::NAN, (f64::NAN, f64::NAN)),
+            None => (est, band),
         };
         rows.push(DiagnosisRow {
             effect: sc.candidate.effect.clone(),
@@ -4587,8 +4587,8 @@ pub fn discover(
                     } else {
                         String::new()
                     },
-                    lo.min(est - 1.96 * se),
-                    hi.max(est + 1.96 * se),
+                    band.0,
+                    band.1,
                 )
             } else if sc.candidate.effect == "position_torque" {
                 format!("k = {}; screened out", sc.candidate.k)
