@@ -4561,6 +4561,12 @@ pub fn discover(
             Some(_) => (f64::NAN, (f64::NAN, f64::NAN)),
             None => (est, band),
         };
+        // A position torque's row names its best k first.
+        let k_words = if sc.candidate.effect == "position_torque" {
+            format!("k = {}; ", sc.candidate.k)
+        } else {
+            String::new()
+        };
         rows.push(DiagnosisRow {
             effect: sc.candidate.effect.clone(),
             accepted: false,
@@ -4581,17 +4587,12 @@ pub fn discover(
             e_validate_after: f64::NAN,
             note: if let Some((a, b)) = range {
                 format!(
-                    "{}not estimable on the identify runs: the screen's 95 % interval, [{:.4e}, {:.4e}] {unit} about {est:.4e}, is wider than the effect's whole range [{a:.4e}, {b:.4e}] (its column hardly moves on their windows: too few where the pendulum moves under the shaker); neither found nor ruled out",
-                    if sc.candidate.effect == "position_torque" {
-                        format!("k = {}; ", sc.candidate.k)
-                    } else {
-                        String::new()
-                    },
+                    "{k_words}not estimable on the identify runs: the screen's 95 % interval, [{:.4e}, {:.4e}] {unit} about {est:.4e}, is wider than the effect's whole range [{a:.4e}, {b:.4e}] (its column hardly moves on their windows: too few where the pendulum moves under the shaker); neither found nor ruled out",
                     band.0,
                     band.1,
                 )
             } else if sc.candidate.effect == "position_torque" {
-                format!("k = {}; screened out", sc.candidate.k)
+                format!("{k_words}screened out")
             } else if sc.candidate.add.iter().all(|c| screened.nuisance.contains(c)) {
                 "within the rig's zeroing tolerance (under 4 counts): kept as a nuisance term, not named".into()
             } else if let Some(simpler) = crate::screen::yields_to(first_round, sc) {
