@@ -4121,7 +4121,7 @@ pub fn discover(
             && refit_range.is_some_and(|(lo, _)| lo > 0.0);
         // Where neither holds and the two views on the identify runs at the trajectories' shape
         // named it (`shape_views_agree`), the equation error's interval there: the screen's is
-        // at its own profile's shape, a size of another torque ([4.5e-3, 0.724] N·m at v_s 0.035
+        // at its own profile's shape, a size of another torque ([1.55e-2, 0.724] N·m at v_s 0.035
         // for the 1.12e-2 N·m breakaway above, named at 1.19e-2 with v_s 0.140).
         let shape_band = at_shape_holds
             .filter(|_| accepted && shape_views_agree)
