@@ -1894,6 +1894,33 @@ fn a_breakaway_whose_two_views_overlap_at_the_trajectories_shape_is_named() {
     );
 }
 
+/// An 8.55e-3 N·m breakaway fading at 0.198 rad/s on a drawn design (`SURVEY_DAMPING=drawn
+/// SURVEY_SEED=8`, `stribeck` k=4), named on the second look where its two identify views
+/// overlap at the trajectories' shape (v_s 0.124; the equation error there 2.23e-2 ± 1.09e-2,
+/// the refit 1.10e-2, the trajectories' range [0, 3.29e-2]), was named with that range, an
+/// interval holding its own absence. Its interval is the equation error's at that shape widened
+/// to hold the value, above 0. (Its size, +21.8 % on every run, misses the 10 %: at the truth's
+/// own v_s the equation error and the trajectories put T_s at about +18 % and +17 %; README.)
+#[test]
+fn a_breakaway_named_where_its_trajectories_reach_zero_reads_an_interval_above_zero() {
+    let (truth, s) = run_as_surveyed_with_damping("stribeck", 802_204, 810_204, 806_204);
+    assert_eq!(s.discovery.accepted(), vec!["stribeck"], "{}", s);
+    let row = s.discovery.row("stribeck").unwrap();
+    assert!(
+        row.refit_ci_low == 0.0
+            && row.ci_low > 0.0
+            && row.ci_low <= row.estimate
+            && row.estimate <= row.ci_high
+            && row.ci_high < 0.1,
+        "named {:.4e} in [{:.4e}, {:.4e}]; trajectories [{:.4e}, {:.4e}]; truth {truth:.4e}",
+        row.estimate,
+        row.ci_low,
+        row.ci_high,
+        row.refit_ci_low,
+        row.refit_ci_high
+    );
+}
+
 /// A 1.08e-2 N·m breakaway on a drawn design (the every-effect survey's `stribeck` k=1,
 /// `SURVEY_SEED=7`), found on the second look, took 20.0 % ± 10.1 % off the validate runs'
 /// forced windows' E_θ, short of the 20.2 % (twice the bar) a second look needs, and was refused.

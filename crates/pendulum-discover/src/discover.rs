@@ -4126,8 +4126,14 @@ pub fn discover(
         let shape_band = at_shape_holds
             .filter(|_| accepted && shape_views_agree)
             .map(|(_, e, s, _, _)| (e - 1.96 * s, e + 1.96 * s));
+        // Before the trajectories' own range where that holds 0: a named effect's interval does
+        // not hold its absence. A 8.55e-3 N·m breakaway (v_s 0.198 rad/s; `SURVEY_DAMPING=drawn
+        // SURVEY_SEED=8`, `stribeck` k=4) named on both views at v_s 0.124 read [0, 3.29e-2].
         let named_band = refit_range
-            .filter(|_| named_by_trajectories || shaped_named_by_trajectories)
+            .filter(|&(lo, _)| {
+                (named_by_trajectories || shaped_named_by_trajectories)
+                    && (lo > 0.0 || shape_band.is_none())
+            })
             .or(shape_band)
             .unwrap_or(ci);
         // The equation-error estimate, so that the estimate and its interval come from the
