@@ -3683,8 +3683,8 @@ pub fn discover(
             at_shape_holds.is_some_and(|(_, e, s, _, _)| (refit_est - e).abs() <= 1.96 * s);
         // (Computed here only where the refit's value alone does not settle it; kept for the
         // named interval below, which asks the same range.)
-        let shape_range = match (at_shape_holds, size_index) {
-            (Some(_), Some(i)) if !refit_in_screen => Some(trajectory_range(
+        let range_of = |i: usize| {
+            trajectory_range(
                 &traj_runs,
                 &spec,
                 &refit_x,
@@ -3692,7 +3692,10 @@ pub fn discover(
                 i,
                 run_zeros,
                 cfg.refit_evals,
-            )),
+            )
+        };
+        let shape_range = match (at_shape_holds, size_index) {
+            (Some(_), Some(i)) if !refit_in_screen => Some(range_of(i)),
             _ => None,
         };
         let shape_views_agree = refit_in_screen
@@ -4090,17 +4093,7 @@ pub fn discover(
         // Its named value's own interval, from the view that gave it.
         let refit_range = match size_index {
             Some(i) if accepted && (shaped_by_trajectories || named_by_trajectories) => {
-                Some(shape_range.unwrap_or_else(|| {
-                    trajectory_range(
-                        &traj_runs,
-                        &spec,
-                        &refit_x,
-                        &traj_ics,
-                        i,
-                        run_zeros,
-                        cfg.refit_evals,
-                    )
-                }))
+                Some(shape_range.unwrap_or_else(|| range_of(i)))
             }
             _ => None,
         };
