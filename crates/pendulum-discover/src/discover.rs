@@ -4120,7 +4120,7 @@ pub fn discover(
             .filter(|_| accepted && shape_views_agree)
             .map(|(_, e, s, _, _)| (e - 1.96 * s, e + 1.96 * s));
         // Before the trajectories' own range where that holds 0: a named effect's interval does
-        // not hold its absence. A 8.55e-3 N·m breakaway (v_s 0.198 rad/s; `SURVEY_DAMPING=drawn
+        // not hold its absence. An 8.55e-3 N·m breakaway (v_s 0.198 rad/s; `SURVEY_DAMPING=drawn
         // SURVEY_SEED=8`, `stribeck` k=4) named on both views at v_s 0.124 read [0, 3.29e-2].
         let named_band = refit_range
             .filter(|&(lo, _)| {
