@@ -1900,7 +1900,7 @@ fn a_breakaway_whose_two_views_overlap_at_the_trajectories_shape_is_named() {
 /// the refit 1.10e-2, the trajectories' range [0, 3.29e-2]), was named with that range, an
 /// interval holding its own absence. Its interval is the equation error's at that shape widened
 /// to hold the value, above 0. (Its size, +21.8 % on every run, misses the 10 %: at the truth's
-/// own v_s the equation error and the trajectories put T_s at about +18 % and +17 %; README.)
+/// own v_s the equation error and the trajectories put T_s at about +18 % and +16 %; README.)
 #[test]
 fn a_breakaway_named_where_its_trajectories_reach_zero_reads_an_interval_above_zero() {
     let (truth, s) = run_as_surveyed_with_damping("stribeck", 802_204, 810_204, 806_204);
