@@ -1860,6 +1860,32 @@ fn a_breakaway_named_at_its_trajectories_value_reads_their_interval() {
     );
 }
 
+/// A 1.06e-2 N·m breakaway on a drawn design (`SURVEY_DAMPING=drawn SURVEY_SEED=6`, `stribeck`
+/// k=2), named on the screen's route at its trajectories' value (+17 %: their profile is flat),
+/// read the screen's interval at its profile's v_s 0.032, [1.10e-2, 0.733], because the refit with
+/// the size set to 0 and the rest held did not fit significantly worse, though the trajectories'
+/// own range, the rest refitted along it, left out 0: [5.84e-3, 2.34e-2]. That range is now the
+/// named interval: it holds the truth and stays above 0.
+#[test]
+fn a_breakaway_whose_trajectories_range_leaves_out_zero_reads_it_as_its_interval() {
+    let (truth, s) = run_as_surveyed_with_damping("stribeck", 602_202, 610_202, 606_202);
+    assert_eq!(s.discovery.accepted(), vec!["stribeck"], "{}", s);
+    let row = s.discovery.row("stribeck").unwrap();
+    assert!(
+        row.refit_ci_low > 0.0
+            && row.ci_low == row.refit_ci_low.min(row.estimate)
+            && row.ci_high == row.refit_ci_high.max(row.estimate)
+            && row.ci_low <= truth
+            && truth <= row.ci_high,
+        "named {:.4e} in [{:.4e}, {:.4e}]; trajectories [{:.4e}, {:.4e}]; truth {truth:.4e}",
+        row.estimate,
+        row.ci_low,
+        row.ci_high,
+        row.refit_ci_low,
+        row.refit_ci_high
+    );
+}
+
 /// A 1.12e-2 N·m breakaway fading at 0.178 rad/s on a drawn design (`SURVEY_DAMPING=drawn
 /// SURVEY_SEED=7`, `stribeck` k=4), refitted at 1.19e-2 with v_s 0.140 and taking 35.5 % ±
 /// 14.0 % off the validate runs' E_θ, was refused as "the trajectory refit disagrees with the

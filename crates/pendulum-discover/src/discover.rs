@@ -4107,9 +4107,12 @@ pub fn discover(
         // rest held (`informative`) may fit worse while the profile, the rest refitted along
         // it, reaches 0 (a 1.09e-2 N·m breakaway whose trajectories held it within [0, 1.50e-2]
         // would have been named with an interval holding its own absence), and there the
-        // screen's interval, which excludes 0, stays.
+        // screen's interval, which excludes 0, stays. The range is the test, not `informative`
+        // beside it: a range leaving out 0 tells the size from its absence where the rest held
+        // may not. A 1.06e-2 N·m breakaway named on the screen's route (`SURVEY_DAMPING=drawn
+        // SURVEY_SEED=6`, `stribeck` k=2) read the screen's [1.10e-2, 0.733] at v_s 0.032
+        // while its trajectories held [5.84e-3, 2.34e-2].
         let shaped_named_by_trajectories = shaped_by_trajectories
-            && informative
             && !(silent || lag_silent)
             && refit_range.is_some_and(|(lo, _)| lo > 0.0);
         // Where neither holds and the two views on the identify runs at the trajectories' shape
