@@ -1843,10 +1843,17 @@ fn offset_and_inertia_pair_is_named(off: u64) {
 #[ignore = "slow set (a survey draw: `stribeck` k=1 at SURVEY_DAMPING=drawn SURVEY_SEED=6): the default suite checks that a shaped effect named on its trajectories reads their interval on a_generator_whose_forced_identify_runs_all_rest_is_refitted_on_their_free_segments; README, Tests"]
 fn a_breakaway_named_at_its_trajectories_value_reads_their_interval() {
     let (truth, s) = run_as_surveyed_with_damping("stribeck", 602_201, 610_201, 606_201);
-    assert_eq!(s.discovery.accepted(), vec!["stribeck"]);
-    let row = s.discovery.row("stribeck").unwrap();
+    assert_named_within_trajectories_range(&s, "stribeck", truth);
+}
+
+/// `effect` named alone, its interval its trajectories' range (leaving out 0) widened to hold
+/// the value named, and holding `truth`.
+fn assert_named_within_trajectories_range(s: &DiscoverSummary, effect: &str, truth: f64) {
+    assert_eq!(s.discovery.accepted(), vec![effect], "{s}");
+    let row = s.discovery.row(effect).unwrap();
     assert!(
-        row.ci_low == row.refit_ci_low.min(row.estimate)
+        row.refit_ci_low > 0.0
+            && row.ci_low == row.refit_ci_low.min(row.estimate)
             && row.ci_high == row.refit_ci_high.max(row.estimate)
             && row.ci_low <= truth
             && truth <= row.ci_high
@@ -1869,21 +1876,7 @@ fn a_breakaway_named_at_its_trajectories_value_reads_their_interval() {
 #[test]
 fn a_breakaway_whose_trajectories_range_leaves_out_zero_reads_it_as_its_interval() {
     let (truth, s) = run_as_surveyed_with_damping("stribeck", 602_202, 610_202, 606_202);
-    assert_eq!(s.discovery.accepted(), vec!["stribeck"], "{}", s);
-    let row = s.discovery.row("stribeck").unwrap();
-    assert!(
-        row.refit_ci_low > 0.0
-            && row.ci_low == row.refit_ci_low.min(row.estimate)
-            && row.ci_high == row.refit_ci_high.max(row.estimate)
-            && row.ci_low <= truth
-            && truth <= row.ci_high,
-        "named {:.4e} in [{:.4e}, {:.4e}]; trajectories [{:.4e}, {:.4e}]; truth {truth:.4e}",
-        row.estimate,
-        row.ci_low,
-        row.ci_high,
-        row.refit_ci_low,
-        row.refit_ci_high
-    );
+    assert_named_within_trajectories_range(&s, "stribeck", truth);
 }
 
 /// A 1.12e-2 N·m breakaway fading at 0.178 rad/s on a drawn design (`SURVEY_DAMPING=drawn
