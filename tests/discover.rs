@@ -1639,7 +1639,13 @@ fn a_breakaway_both_identify_views_size_alike_at_the_trajectories_shape_is_named
     let (truth, spec, base, a, b, mu) = draw_scaled("stribeck", &mut rng(702_204), 1.0, None);
     let s = discover(706_204, base, a, b, mu, &spec);
     assert_found(&s, "stribeck", truth, 0.10, 0.0);
-    let row = s.discovery.row("stribeck").unwrap();
+    assert_identify_views_agree_at_the_trajectories_shape(&s, "stribeck");
+}
+
+/// `effect`'s note says it was named on the identify runs' two views agreeing at its
+/// trajectories' shape.
+fn assert_identify_views_agree_at_the_trajectories_shape(s: &DiscoverSummary, effect: &str) {
+    let row = s.discovery.row(effect).unwrap();
     assert!(
         row.note
             .contains("the two views on the identify runs agree"),
@@ -1905,12 +1911,7 @@ fn a_breakaway_whose_two_views_overlap_at_the_trajectories_shape_is_named() {
         row.ci_low,
         row.ci_high
     );
-    assert!(
-        row.note
-            .contains("the two views on the identify runs agree"),
-        "{}",
-        row.note
-    );
+    assert_identify_views_agree_at_the_trajectories_shape(&s, "stribeck");
 }
 
 /// An 8.55e-3 N·m breakaway fading at 0.198 rad/s on a drawn design (`SURVEY_DAMPING=drawn
