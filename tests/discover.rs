@@ -5,7 +5,7 @@
 
 use std::path::Path;
 
-use pendulum_discover::Base;
+use pendulum_discover::{Base, DiagnosisRow};
 use pendulum_jobs::discover::{run, DiscoverJob, DiscoverSummary};
 use rand::{RngExt, SeedableRng};
 
@@ -95,6 +95,12 @@ fn assert_pooled_envelope(s: &DiscoverSummary, term: &str, truth: f64, b_rel: f6
         "{term} {} vs {truth}",
         t.estimate
     );
+}
+
+/// The row of `effect`, asserting it is the one effect named (the summary printed if not).
+fn named_alone<'a>(s: &'a DiscoverSummary, effect: &str) -> &'a DiagnosisRow {
+    assert_eq!(s.discovery.accepted(), vec![effect], "{s}");
+    s.discovery.row(effect).unwrap()
 }
 
 /// Exactly `effect` accepted, its estimate within `rel` (or `abs`) of the truth, positive gain.
@@ -999,8 +1005,7 @@ fn an_accepted_effect_is_not_judged_again_by_a_later_round() {
     for r in &s.discovery.rows {
         eprintln!("note {}: {}", r.effect, r.note);
     }
-    assert_eq!(s.discovery.accepted(), vec!["position_torque"]);
-    let row = s.discovery.row("position_torque").unwrap();
+    let row = named_alone(&s, "position_torque");
     assert!(row.note.starts_with("k = 4;"), "{}", row.note);
     assert!(
         (row.estimate / truth - 1.0).abs() <= 0.10,
@@ -1075,8 +1080,7 @@ fn a_lag_the_validate_runs_e_theta_cannot_see_is_judged_on_their_equation_error(
 /// rise, which is the point): alone, within `tol_s` of `truth`, its interval above 0, their
 /// equation error falling by more than half, and its row saying why (`note`).
 fn assert_lag_named_on_its_equation_error(s: &DiscoverSummary, truth: f64, tol_s: f64, note: &str) {
-    assert_eq!(s.discovery.accepted(), vec!["accel_delay"]);
-    let row = s.discovery.row("accel_delay").unwrap();
+    let row = named_alone(s, "accel_delay");
     assert!(
         (row.estimate - truth).abs() <= tol_s && row.ci_low > 0.0,
         "estimate {} [{}, {}] vs truth {truth}",
@@ -1855,8 +1859,7 @@ fn a_breakaway_named_at_its_trajectories_value_reads_their_interval() {
 /// `effect` named alone, its interval its trajectories' range (leaving out 0) widened to hold
 /// the value named, and holding `truth`.
 fn assert_named_within_trajectories_range(s: &DiscoverSummary, effect: &str, truth: f64) {
-    assert_eq!(s.discovery.accepted(), vec![effect], "{s}");
-    let row = s.discovery.row(effect).unwrap();
+    let row = named_alone(s, effect);
     assert!(
         row.refit_ci_low > 0.0
             && row.ci_low == row.refit_ci_low.min(row.estimate)
@@ -1897,8 +1900,7 @@ fn a_breakaway_whose_trajectories_range_leaves_out_zero_reads_it_as_its_interval
 #[test]
 fn a_breakaway_whose_two_views_overlap_at_the_trajectories_shape_is_named() {
     let (truth, s) = run_as_surveyed_with_damping("stribeck", 702_204, 710_204, 706_204);
-    assert_eq!(s.discovery.accepted(), vec!["stribeck"], "{}", s);
-    let row = s.discovery.row("stribeck").unwrap();
+    let row = named_alone(&s, "stribeck");
     assert!(
         (row.estimate - truth).abs() <= 0.10 * truth,
         "estimate {:.4e} vs truth {truth:.4e}",
@@ -1924,8 +1926,7 @@ fn a_breakaway_whose_two_views_overlap_at_the_trajectories_shape_is_named() {
 #[test]
 fn a_breakaway_named_where_its_trajectories_reach_zero_reads_an_interval_above_zero() {
     let (truth, s) = run_as_surveyed_with_damping("stribeck", 802_204, 810_204, 806_204);
-    assert_eq!(s.discovery.accepted(), vec!["stribeck"], "{}", s);
-    let row = s.discovery.row("stribeck").unwrap();
+    let row = named_alone(&s, "stribeck");
     assert!(
         row.refit_ci_low == 0.0
             && row.ci_low > 0.0
@@ -1953,8 +1954,7 @@ fn a_breakaway_named_where_its_trajectories_reach_zero_reads_an_interval_above_z
 fn a_breakaway_is_judged_on_the_validate_runs_free_segments_too() {
     let (truth, spec, base, a, b, mu) = draw_scaled("stribeck", &mut rng(702_201), 1.0, None);
     let s = discover(706_201, base, a, b, mu, &spec);
-    assert_eq!(s.discovery.accepted(), vec!["stribeck"]);
-    let row = s.discovery.row("stribeck").unwrap();
+    let row = named_alone(&s, "stribeck");
     assert!(
         (row.estimate - truth).abs() <= 0.10 * truth,
         "estimate {:.4e} vs truth {truth:.4e}",
