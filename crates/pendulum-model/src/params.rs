@@ -248,6 +248,12 @@ pub struct Dimensionless {
     pub c_lobes_k: u32,
     #[serde(default)]
     pub c_lobes_phase: f64,
+    /// A drag growing as the cube of the speed, −γ θ̇³ with γ = c ω0³/(m g l) for a torque
+    /// c θ̇³ in N·m (a paddle whose wake turns turbulent, a grease that thickens with shear):
+    /// a departure outside the catalogue, whose viscous and quadratic drags only approximate
+    /// it, for tests of an honest `unexplained`. Absent = 0.
+    #[serde(default)]
+    pub cubic_drag: f64,
 }
 
 impl Default for Dimensionless {
@@ -314,6 +320,7 @@ impl Dimensionless {
             c_lobes: 0.0,
             c_lobes_k: 1,
             c_lobes_phase: 0.0,
+            cubic_drag: 0.0,
         }
     }
 
@@ -392,6 +399,13 @@ impl Dimensionless {
                 self.c_lobes,
                 false,
                 Some((self.c_lobes >= 0.0, NON_NEG)),
+            ),
+            slot(
+                "cubic_drag",
+                "γ",
+                self.cubic_drag,
+                false,
+                Some((self.cubic_drag >= 0.0, NON_NEG)),
             ),
             slot("p", "p", self.p, false, None),
         ];

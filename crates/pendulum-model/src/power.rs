@@ -148,7 +148,8 @@ pub fn mean_powers(
         let wt = trapezoid_weight(i, n, dt);
         acc.base += wt * tq.base * w;
         acc.viscous -= wt * tq.viscous * w;
-        acc.quadratic -= wt * tq.quadratic * w;
+        // (A departure's cubic drag is a speed-power drag too.)
+        acc.quadratic -= wt * (tq.quadratic + tq.cubic) * w;
         acc.dry -= wt * tq.dry * w;
         acc.generator -= wt * tq.generator * w;
         acc.load += wt * p.gen_c * excess * excess;

@@ -188,6 +188,10 @@ impl Model {
         if p.kappa != 0.0 {
             q -= p.kappa * p.spring_stretch(theta);
         }
+        // Tested, not multiplied by zero: only a departure's tests have it.
+        if p.cubic_drag != 0.0 {
+            q -= p.cubic_drag * theta_dot * w2;
+        }
         if p.j != 0.0 {
             q / (1.0 + p.j)
         } else {
@@ -231,6 +235,7 @@ impl Model {
             generator: -p.gen_c * excess * dir,
             position: -p.p * (p.k as f64 * theta + p.phi_p).sin(),
             spring: -p.kappa * p.spring_stretch(theta),
+            cubic: -p.cubic_drag * theta_dot * theta_dot * theta_dot,
         }
     }
 
@@ -257,6 +262,8 @@ pub struct Torques {
     pub generator: f64,
     pub position: f64,
     pub spring: f64,
+    /// The cubic drag of a departure, −γ θ̇³ ([`Dimensionless::cubic_drag`]).
+    pub cubic: f64,
 }
 
 impl Torques {
@@ -269,6 +276,7 @@ impl Torques {
             + self.generator
             + self.position
             + self.spring
+            + self.cubic
     }
 }
 

@@ -51,6 +51,7 @@ fn rhs(model: &Model, m: Mount, t: f64, y: State) -> State {
     let q = rho * (tq.gravity + tq.base)
         + rho * rho * tq.viscous
         + rho * rho * rho * tq.quadratic
+        + rho.powi(4) * tq.cubic
         + dry
         + tq.generator
         + tq.position

@@ -146,6 +146,11 @@ pub struct Departures {
     /// see it (effects.md's `horizontal_base` is a tilt the accelerometer's x axis sees).
     #[serde(default)]
     pub axis_sway_ratio: Option<f64>,
+    /// A drag growing as the cube of the speed (a paddle whose wake turns turbulent, a grease
+    /// that thickens with shear): a torque −c θ̇³, this c in N·m·s³/rad³. The catalogue's
+    /// viscous and quadratic drags only approximate it.
+    #[serde(default)]
+    pub cubic_drag_nm_s3_per_rad3: Option<f64>,
 }
 
 impl Departures {
@@ -259,6 +264,12 @@ impl Departures {
                     "dry_torque_lobes_phase_rad"
                 },
                 "a lobe count or phase beside a dry_torque_lobes_nm (alone it has no torque to shape)",
+            ));
+        }
+        if bad(self.cubic_drag_nm_s3_per_rad3, |v| v >= 0.0) {
+            return Some((
+                "cubic_drag_nm_s3_per_rad3",
+                "a finite drag coefficient ≥ 0 N·m·s³/rad³ (below 0 it would feed energy in)",
             ));
         }
         if bad(self.dry_torque_growth_nm_per_s, |v| v >= 0.0) {
@@ -732,6 +743,10 @@ fn synthesize_run(
             .departures
             .dry_torque_lobes_phase_rad
             .unwrap_or(0.0);
+    }
+    if let Some(c) = case.truth.departures.cubic_drag_nm_s3_per_rad3 {
+        // θ̇ = ω0 θ̇' (θ̇' per dimensionless time), per m g l.
+        d.cubic_drag = c * phys.omega0_rad_s().powi(3) / (phys.m_kg * phys.g_m_s2 * phys.l_m);
     }
     // A swaying bracket moves the axis as a tilt would, unseen by the accelerometer (below).
     let sway = case.truth.departures.axis_sway_ratio.unwrap_or(0.0);
