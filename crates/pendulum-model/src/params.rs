@@ -254,6 +254,14 @@ pub struct Dimensionless {
     /// it, for tests of an honest `unexplained`. Absent = 0.
     #[serde(default)]
     pub cubic_drag: f64,
+    /// A viscous drag acting over part of the turn, −β_e θ̇ (1 + cos(θ − φ_e))/2 with β_e =
+    /// c_e ω0/(m g l) for a torque c_e θ̇ in N·m·s/rad where it is strongest (an eddy-current
+    /// brake: a magnet beside the swing at φ_e): a departure outside the catalogue, whose drag
+    /// is the same all around the turn, for tests of an honest `unexplained`. Absent = 0.
+    #[serde(default)]
+    pub eddy_brake: f64,
+    #[serde(default)]
+    pub eddy_brake_phase: f64,
 }
 
 impl Default for Dimensionless {
@@ -292,6 +300,12 @@ impl Dimensionless {
         self.c_lobes * (1.0 + (f64::from(self.c_lobes_k) * theta - self.c_lobes_phase).cos())
     }
 
+    /// The share of the eddy brake's full drag acting at θ, (1 + cos(θ − φ_e))/2.
+    #[inline]
+    pub fn eddy_share(&self, theta: f64) -> f64 {
+        0.5 * (1.0 + (theta - self.eddy_brake_phase).cos())
+    }
+
     /// A free pendulum with no damping and no base motion.
     pub fn conservative() -> Self {
         Self {
@@ -321,6 +335,8 @@ impl Dimensionless {
             c_lobes_k: 1,
             c_lobes_phase: 0.0,
             cubic_drag: 0.0,
+            eddy_brake: 0.0,
+            eddy_brake_phase: 0.0,
         }
     }
 
@@ -407,8 +423,24 @@ impl Dimensionless {
                 false,
                 Some((self.cubic_drag >= 0.0, NON_NEG)),
             ),
+            slot(
+                "eddy_brake",
+                "β_e",
+                self.eddy_brake,
+                false,
+                Some((self.eddy_brake >= 0.0, NON_NEG)),
+            ),
             slot("p", "p", self.p, false, None),
         ];
+        if self.eddy_brake != 0.0 {
+            out.push(slot(
+                "eddy_brake_phase",
+                "φ_e",
+                self.eddy_brake_phase,
+                true,
+                None,
+            ));
+        }
         if self.c_lobes != 0.0 {
             out.push(slot(
                 "c_lobes_k",

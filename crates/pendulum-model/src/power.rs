@@ -147,7 +147,8 @@ pub fn mean_powers(
         let excess = (w.abs() - p.gen_w).max(0.0);
         let wt = trapezoid_weight(i, n, dt);
         acc.base += wt * tq.base * w;
-        acc.viscous -= wt * tq.viscous * w;
+        // (A departure's eddy brake is a viscous drag too.)
+        acc.viscous -= wt * (tq.viscous + tq.eddy) * w;
         // (A departure's cubic drag is a speed-power drag too.)
         acc.quadratic -= wt * (tq.quadratic + tq.cubic) * w;
         acc.dry -= wt * tq.dry * w;

@@ -192,6 +192,9 @@ impl Model {
         if p.cubic_drag != 0.0 {
             q -= p.cubic_drag * theta_dot * w2;
         }
+        if p.eddy_brake != 0.0 {
+            q -= p.eddy_brake * theta_dot * p.eddy_share(theta);
+        }
         if p.j != 0.0 {
             q / (1.0 + p.j)
         } else {
@@ -236,6 +239,7 @@ impl Model {
             position: -p.p * (p.k as f64 * theta + p.phi_p).sin(),
             spring: -p.kappa * p.spring_stretch(theta),
             cubic: -p.cubic_drag * theta_dot * theta_dot * theta_dot,
+            eddy: -p.eddy_brake * theta_dot * p.eddy_share(theta),
         }
     }
 
@@ -264,6 +268,9 @@ pub struct Torques {
     pub spring: f64,
     /// The cubic drag of a departure, −γ θ̇³ ([`Dimensionless::cubic_drag`]).
     pub cubic: f64,
+    /// The eddy brake of a departure, −β_e θ̇ (1 + cos(θ − φ_e))/2
+    /// ([`Dimensionless::eddy_brake`]).
+    pub eddy: f64,
 }
 
 impl Torques {
@@ -277,6 +284,7 @@ impl Torques {
             + self.position
             + self.spring
             + self.cubic
+            + self.eddy
     }
 }
 

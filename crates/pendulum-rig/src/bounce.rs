@@ -52,6 +52,7 @@ fn rhs(model: &Model, m: Mount, t: f64, y: State) -> State {
         + rho * rho * tq.viscous
         + rho * rho * rho * tq.quadratic
         + rho.powi(4) * tq.cubic
+        + rho * rho * tq.eddy
         + dry
         + tq.generator
         + tq.position

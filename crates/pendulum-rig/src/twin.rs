@@ -151,6 +151,14 @@ pub struct Departures {
     /// viscous and quadratic drags only approximate it.
     #[serde(default)]
     pub cubic_drag_nm_s3_per_rad3: Option<f64>,
+    /// A viscous drag over part of the turn (an eddy-current brake: a magnet beside the swing):
+    /// a torque −c θ̇ (1 + cos(θ − φ))/2, this c in N·m·s/rad where it is strongest.
+    #[serde(default)]
+    pub eddy_brake_nm_s_per_rad: Option<f64>,
+    /// Where the eddy brake is strongest, φ, rad (default 0, the hanging position; with
+    /// `eddy_brake_nm_s_per_rad`).
+    #[serde(default)]
+    pub eddy_brake_phase_rad: Option<f64>,
 }
 
 impl Departures {
@@ -264,6 +272,23 @@ impl Departures {
                     "dry_torque_lobes_phase_rad"
                 },
                 "a lobe count or phase beside a dry_torque_lobes_nm (alone it has no torque to shape)",
+            ));
+        }
+        if bad(self.eddy_brake_nm_s_per_rad, |v| v >= 0.0) {
+            return Some((
+                "eddy_brake_nm_s_per_rad",
+                "a finite drag coefficient ≥ 0 N·m·s/rad (below 0 it would feed energy in)",
+            ));
+        }
+        if bad(self.eddy_brake_phase_rad, |v| {
+            v.abs() <= 2.0 * std::f64::consts::PI
+        }) {
+            return Some(("eddy_brake_phase_rad", "a finite phase within ±2π rad"));
+        }
+        if self.eddy_brake_phase_rad.is_some() && self.eddy_brake_nm_s_per_rad.is_none() {
+            return Some((
+                "eddy_brake_phase_rad",
+                "a phase beside an eddy_brake_nm_s_per_rad (alone it has no brake to place)",
             ));
         }
         if bad(self.cubic_drag_nm_s3_per_rad3, |v| v >= 0.0) {
@@ -747,6 +772,10 @@ fn synthesize_run(
     if let Some(c) = case.truth.departures.cubic_drag_nm_s3_per_rad3 {
         // θ̇ = ω0 θ̇' (θ̇' per dimensionless time), per m g l.
         d.cubic_drag = c * phys.omega0_rad_s().powi(3) / (phys.m_kg * phys.g_m_s2 * phys.l_m);
+    }
+    if let Some(c) = case.truth.departures.eddy_brake_nm_s_per_rad {
+        d.eddy_brake = c * phys.omega0_rad_s() / (phys.m_kg * phys.g_m_s2 * phys.l_m);
+        d.eddy_brake_phase = case.truth.departures.eddy_brake_phase_rad.unwrap_or(0.0);
     }
     // A swaying bracket moves the axis as a tilt would, unseen by the accelerometer (below).
     let sway = case.truth.departures.axis_sway_ratio.unwrap_or(0.0);
