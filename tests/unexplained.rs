@@ -960,20 +960,8 @@ fn an_off_centre_code_disc_is_not_named_an_inertia_its_trajectories_put_within_t
 /// say the error follows θ (mod 2π).
 #[test]
 fn an_off_centre_code_disc_is_not_named_a_position_torque_on_the_equation_error_alone() {
-    let (seed, b, mu, departure) = drawn_departure("encoder_eccentricity", 4, 1_000_000);
-    let s = discover_with(seed, b, mu, &departure);
-    let d = &s.discovery;
-    assert!(
-        d.accepted().is_empty(),
-        "{departure}: named {:?}",
-        d.accepted()
-    );
-    let row = d.row("position_torque").expect("a position torque row");
-    assert!(
-        row.note.contains("rests on the equation error alone"),
-        "{}",
-        row.note
-    );
+    let d =
+        position_torque_refused_on_the_equation_error_alone("encoder_eccentricity", 4, 1_000_000);
     let words = d.unexplained.as_deref().expect("`unexplained` said");
     assert!(words.contains("θ (mod 2π)"), "{words}");
 }
@@ -986,9 +974,21 @@ fn an_off_centre_code_disc_is_not_named_a_position_torque_on_the_equation_error_
 /// position torque's row says why, and the words follow dθ/dt.
 #[test]
 fn a_growing_friction_is_not_named_a_position_torque_on_a_bare_e_theta_pass() {
-    let (seed, b, mu, departure) = drawn_departure("dry_torque_growth", 4, 1_100_000);
-    let s = discover_with(seed, b, mu, &departure);
-    let d = &s.discovery;
+    let d = position_torque_refused_on_the_equation_error_alone("dry_torque_growth", 4, 1_100_000);
+    let desc = d.unexplained_description.as_ref().expect("a description");
+    assert_eq!(desc.variable, Variable::Rate, "{desc:?}");
+}
+
+/// Runs the departure survey's campaign `k` of `name` (draws shifted by `off`) and checks that
+/// nothing is named and that the position torque's row says its size rests on the equation
+/// error alone; returns the discovery.
+fn position_torque_refused_on_the_equation_error_alone(
+    name: &str,
+    k: u64,
+    off: u64,
+) -> pendulum_discover::Discovery {
+    let (seed, b, mu, departure) = drawn_departure(name, k, off);
+    let d = discover_with(seed, b, mu, &departure).discovery;
     assert!(
         d.accepted().is_empty(),
         "{departure}: named {:?}",
@@ -1000,8 +1000,7 @@ fn a_growing_friction_is_not_named_a_position_torque_on_a_bare_e_theta_pass() {
         "{}",
         row.note
     );
-    let desc = d.unexplained_description.as_ref().expect("a description");
-    assert_eq!(desc.variable, Variable::Rate, "{desc:?}");
+    d
 }
 
 /// Runs the departure survey's campaign `k` of `name` (draws shifted by `off`) and checks that
