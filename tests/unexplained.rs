@@ -966,19 +966,6 @@ fn an_off_centre_code_disc_is_not_named_a_position_torque_on_the_equation_error_
     assert!(words.contains("θ (mod 2π)"), "{words}");
 }
 
-/// A dry torque growing 5.7e-4 N·m/s (the departure survey's `dry_torque_growth` draw 4 at
-/// `DEPARTURE_SEED=11`, first drawn on 5fc8793) was named a k = 1 position torque, screened at
-/// 3.4e-3 N·m [1.8e-3, 5.0e-3] and refitted at 1.1e-3 (the trajectories fitting the screen's value
-/// as well), on the validate runs' E_θ falling 11.1 % ± 10.1 %, a bare pass. Where the
-/// trajectories do not measure the size, that view must clear twice its bar: nothing named, the
-/// position torque's row says why, and the words follow dθ/dt.
-#[test]
-fn a_growing_friction_is_not_named_a_position_torque_on_a_bare_e_theta_pass() {
-    let d = position_torque_refused_on_the_equation_error_alone("dry_torque_growth", 4, 1_100_000);
-    let desc = d.unexplained_description.as_ref().expect("a description");
-    assert_eq!(desc.variable, Variable::Rate, "{desc:?}");
-}
-
 /// Runs the departure survey's campaign `k` of `name` (draws shifted by `off`) and checks that
 /// nothing is named and that the position torque's row says its size rests on the equation
 /// error alone; returns the discovery.
