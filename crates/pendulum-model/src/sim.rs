@@ -145,11 +145,11 @@ impl Model {
     }
 
     /// θ̈ with the generator held in mode `gen` ([`Model::gen_mode`]): the integrator's smooth
-    /// right-hand side within a step. `STRIBECK` / `GEN` false compile the breakaway / generator
-    /// term out (chosen once per integration from the coefficients, see [`integrate`]); true keeps
+    /// right-hand side within a step. `STRIBECK` / `RARE` false compile the breakaway / the
+    /// generator and the departures' drags out (chosen once per integration from the coefficients, see [`integrate`]); true keeps
     /// the run-time test of the coefficient, so `<true, true>` is right for every model.
     #[inline(always)]
-    fn accel_in<const STRIBECK: bool, const GEN: bool>(
+    fn accel_in<const STRIBECK: bool, const RARE: bool>(
         &self,
         t: f64,
         theta: f64,
@@ -179,7 +179,7 @@ impl Model {
             q -= dry * dir;
         }
         // Tested first: most models have no generator, and those that do spend time in its band.
-        if GEN && p.gen_c != 0.0 && gen != 0.0 {
+        if RARE && p.gen_c != 0.0 && gen != 0.0 {
             q -= p.gen_c * (theta_dot - gen * p.gen_w);
         }
         if p.p != 0.0 {
@@ -188,11 +188,12 @@ impl Model {
         if p.kappa != 0.0 {
             q -= p.kappa * p.spring_stretch(theta);
         }
-        // Tested, not multiplied by zero: only a departure's tests have it.
-        if p.cubic_drag != 0.0 {
+        // The departures' drags (only a departure's tests have them) go with the generator's
+        // rarely present term (`RARE`).
+        if RARE && p.cubic_drag != 0.0 {
             q -= p.cubic_drag * theta_dot * w2;
         }
-        if p.eddy_brake != 0.0 {
+        if RARE && p.eddy_brake != 0.0 {
             q -= p.eddy_brake * theta_dot * p.eddy_share(theta);
         }
         if p.j != 0.0 {
@@ -532,7 +533,8 @@ where
     // simulator bench must not slow down"). Each variant computes the same numbers as the
     // general one, since a term compiled out is one whose coefficient is zero.
     let p = &model.params;
-    match (p.s_break != 0.0, p.gen_c != 0.0) {
+    let rare = p.gen_c != 0.0 || p.cubic_drag != 0.0 || p.eddy_brake != 0.0;
+    match (p.s_break != 0.0, rare) {
         (false, false) => {
             integrate_with::<false, false, I, F>(model, opts, t0, y0, t_end, times, sink)
         }
@@ -546,8 +548,9 @@ where
     }
 }
 
-/// [`integrate`] with the breakaway (`STRIBECK`) and generator (`GEN`) terms compiled in or out.
-fn integrate_with<const STRIBECK: bool, const GEN: bool, I, F>(
+/// [`integrate`] with the breakaway (`STRIBECK`) and the generator and departure drags (`RARE`)
+/// compiled in or out.
+fn integrate_with<const STRIBECK: bool, const RARE: bool, I, F>(
     model: &Model,
     opts: &SimOptions,
     t0: f64,
@@ -613,8 +616,8 @@ where
         dir = 0.0;
     }
     // The generator's mode (see the module docs); it switches only where its dead band has an
-    // edge (w > 0). GEN is true exactly when g ≠ 0.
-    let gen_switch = GEN && model.params.gen_w > 0.0;
+    // edge (w > 0). RARE is true whenever g ≠ 0 (and for the departures' drags).
+    let gen_switch = RARE && model.params.gen_w > 0.0;
     let mut gen = model.gen_mode(y[1]);
     // Events that made no progress in a row (a guard against Zeno behaviour).
     let mut idle_events = 0u32;
@@ -673,7 +676,7 @@ where
             });
         }
         if need_k1 {
-            k1 = f::<STRIBECK, GEN>(model, t, y, dir, gen);
+            k1 = f::<STRIBECK, RARE>(model, t, y, dir, gen);
             stats.rhs_evals += 1;
             need_k1 = false;
         }
@@ -682,22 +685,22 @@ where
             h = t_end - t;
         }
         // One DOPRI5 step.
-        let k2 = f::<STRIBECK, GEN>(model, t + dp::C2 * h, add(y, h, &[(dp::A21, k1)]), dir, gen);
-        let k3 = f::<STRIBECK, GEN>(
+        let k2 = f::<STRIBECK, RARE>(model, t + dp::C2 * h, add(y, h, &[(dp::A21, k1)]), dir, gen);
+        let k3 = f::<STRIBECK, RARE>(
             model,
             t + dp::C3 * h,
             add(y, h, &[(dp::A31, k1), (dp::A32, k2)]),
             dir,
             gen,
         );
-        let k4 = f::<STRIBECK, GEN>(
+        let k4 = f::<STRIBECK, RARE>(
             model,
             t + dp::C4 * h,
             add(y, h, &[(dp::A41, k1), (dp::A42, k2), (dp::A43, k3)]),
             dir,
             gen,
         );
-        let k5 = f::<STRIBECK, GEN>(
+        let k5 = f::<STRIBECK, RARE>(
             model,
             t + dp::C5 * h,
             add(
@@ -719,7 +722,7 @@ where
                 (dp::A65, k5),
             ],
         );
-        let k6 = f::<STRIBECK, GEN>(model, t + h, y6, dir, gen);
+        let k6 = f::<STRIBECK, RARE>(model, t + h, y6, dir, gen);
         let y_new = add(
             y,
             h,
@@ -731,7 +734,7 @@ where
                 (dp::A76, k6),
             ],
         );
-        let k7 = f::<STRIBECK, GEN>(model, t + h, y_new, dir, gen);
+        let k7 = f::<STRIBECK, RARE>(model, t + h, y_new, dir, gen);
         stats.rhs_evals += 6;
         let mut err = 0.0;
         for i in 0..2 {
@@ -865,7 +868,7 @@ where
                 yb[1] = side * w;
                 // On the edge both modes give the same θ̈ (the torque is continuous): its sign
                 // says which side the motion goes on to.
-                let a = model.accel_in::<STRIBECK, GEN>(tb, yb[0], yb[1], dir, 0.0);
+                let a = model.accel_in::<STRIBECK, RARE>(tb, yb[0], yb[1], dir, 0.0);
                 gen = if a * side > 0.0 { side } else { 0.0 };
                 t = tb;
                 y = yb;
@@ -953,10 +956,10 @@ where
 }
 
 #[inline]
-fn f<const STRIBECK: bool, const GEN: bool>(model: &Model, t: f64, y: Y, dir: f64, gen: f64) -> Y {
+fn f<const STRIBECK: bool, const RARE: bool>(model: &Model, t: f64, y: Y, dir: f64, gen: f64) -> Y {
     [
         y[1],
-        model.accel_in::<STRIBECK, GEN>(t, y[0], y[1], dir, gen),
+        model.accel_in::<STRIBECK, RARE>(t, y[0], y[1], dir, gen),
     ]
 }
 
