@@ -622,8 +622,13 @@ pub fn views_agree(
     if !(refit.is_finite() && refit * screen > 0.0) {
         return false;
     }
-    let band = half_width.max(AGREEMENT_REL * screen.abs());
-    (refit - screen).abs() <= band || screen_fits_trajectories
+    refit_within_band(screen, half_width, refit) || screen_fits_trajectories
+}
+
+/// The refit's value inside the screen's: within its half-width or [`AGREEMENT_REL`] of its
+/// estimate, whichever is wider (the first way [`views_agree`] holds).
+fn refit_within_band(screen: f64, half_width: f64, refit: f64) -> bool {
+    (refit - screen).abs() <= half_width.max(AGREEMENT_REL * screen.abs())
 }
 
 /// `x` inside the bounds the refit keeps its parameters to.
@@ -3557,8 +3562,7 @@ pub fn discover(
         // 11 % lower, took 44.2 % ± 26.3 % off E_θ and 97.6 % off the equation error, and twice
         // the bar lost it. A dry torque growing with time, `DEPARTURE_SEED=11`
         // `dry_torque_growth` k=4, is still named a position torque on 11.1 % ± 10.1 %.)
-        let refit_in_band = refit_est.is_finite()
-            && (refit_est - est).abs() <= agree_half.max(AGREEMENT_REL * est.abs());
+        let refit_in_band = refit_est.is_finite() && refit_within_band(est, agree_half, refit_est);
         let size_on_equation_error_alone =
             agree && !refit_in_band && !(gain > gain_needed) && !e_theta_cannot_see;
         // A freer shape in the effect's own variable that does clearly better makes the
