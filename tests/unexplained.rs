@@ -953,19 +953,46 @@ fn an_off_centre_code_disc_is_not_named_an_inertia_its_trajectories_put_within_t
 /// say the error follows θ (mod 2π).
 #[test]
 fn an_off_centre_code_disc_is_not_named_a_position_torque_on_the_equation_error_alone() {
-    let d =
-        position_torque_refused_on_the_equation_error_alone("encoder_eccentricity", 4, 1_000_000);
+    let d = position_torque_refused(
+        "encoder_eccentricity",
+        4,
+        1_000_000,
+        "rests on the equation error alone",
+    );
     let words = d.unexplained.as_deref().expect("`unexplained` said");
     assert!(words.contains("θ (mod 2π)"), "{words}");
 }
 
+/// A dry torque growing with time, 5.7e-4 N·m/s (the departure survey's draw 4 at
+/// `DEPARTURE_SEED=11`, first drawn on 5fc8793), was named a k = 1 position torque: screened at
+/// 3.4e-3 N·m [1.8e-3, 5.0e-3], refitted at 1.1e-3, the two "agreeing" only because the
+/// trajectories fit the screen's value as well as their own, and confirmed by the validate runs'
+/// E_θ at the refit's value (11.1 % ± 10.1 %) but not at the screen's (19.9 % ± 22.9 %): the two
+/// views put it at different sizes. Nothing named, the position torque's row says why, and the
+/// words say the remaining torque follows dθ/dt and grows with time (t sgn θ̇).
+#[test]
+fn a_growing_dry_torque_is_not_named_a_position_torque_its_e_theta_confirms_at_another_size() {
+    let d = position_torque_refused(
+        "dry_torque_growth",
+        4,
+        1_100_000,
+        "at the refit's value but not at the screen's",
+    );
+    let words = d.unexplained.as_deref().expect("`unexplained` said");
+    assert!(
+        words.contains("follows dθ/dt") && words.contains("t sgn θ̇"),
+        "{words}"
+    );
+}
+
 /// Runs the departure survey's campaign `k` of `name` (draws shifted by `off`) and checks that
-/// nothing is named and that the position torque's row says its size rests on the equation
-/// error alone; returns the discovery.
-fn position_torque_refused_on_the_equation_error_alone(
+/// nothing is named and that the position torque's row gives `why` it was not; returns the
+/// discovery.
+fn position_torque_refused(
     name: &str,
     k: u64,
     off: u64,
+    why: &str,
 ) -> pendulum_discover::Discovery {
     let (seed, b, mu, departure) = drawn_departure(name, k, off);
     let d = discover_with(seed, b, mu, &departure).discovery;
@@ -975,11 +1002,7 @@ fn position_torque_refused_on_the_equation_error_alone(
         d.accepted()
     );
     let row = d.row("position_torque").expect("a position torque row");
-    assert!(
-        row.note.contains("rests on the equation error alone"),
-        "{}",
-        row.note
-    );
+    assert!(row.note.contains(why), "{}", row.note);
     d
 }
 
