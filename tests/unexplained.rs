@@ -384,6 +384,9 @@ fn a_bouncing_bob_is_unexplained_and_follows_the_rate() {
 /// round's other candidates beside it: the inertia 2.48e-2 kg·m² against 7.18e-3; the torque
 /// 0.817 N·m against 0.082), so one size does not
 /// describe the departure and nothing may be named; the refused row's note gives both values.
+/// Since c6865ca a rule asked before that one refuses a candidate of each draw for the same
+/// reason, one size not describing it: the validate runs' E_θ falls at the refit's size but not
+/// at the screen's (the inertia of draw 3, the torque of draw 2), and the row says so instead.
 #[test]
 #[ignore = "slow set (two kept draws, 50 s on 2 cores): the default suite checks a bouncing bob on a_bouncing_bob_is_unexplained_and_follows_the_rate and the rule on the unit test sizes_disagree_only_apart_beyond_both_intervals_and_the_promised_accuracy; docs/discovery.md, A partial explanation is not a cause"]
 fn a_bouncing_bob_whose_validate_runs_size_it_elsewhere_is_not_named() {
@@ -403,7 +406,9 @@ fn a_bouncing_bob_whose_validate_runs_size_it_elsewhere_is_not_named() {
         assert!(
             d.rows.iter().any(|r| r
                 .note
-                .contains("validate runs' own rows put its size elsewhere")),
+                .contains("validate runs' own rows put its size elsewhere")
+                || r.note
+                    .contains("at the refit's value but not at the screen's")),
             "draw {k} (+{off}): no candidate refused for its held-out size: {:#?}",
             d.rows
                 .iter()
