@@ -933,20 +933,14 @@ fn a_friction_that_differs_on_the_validate_runs_is_not_named_a_generator() {
 /// why.
 #[test]
 fn a_friction_that_differs_from_run_to_run_is_not_named_a_generator_at_zero_dead_band() {
-    let (seed, b, mu, departure) = drawn_departure("mu_run_spread", 4, 1_300_000);
-    let d = discover_with(seed, b, mu, &departure).discovery;
-    assert!(
-        d.accepted().is_empty(),
-        "{departure}: named {:?}",
-        d.accepted()
+    let d = refused(
+        "mu_run_spread",
+        4,
+        1_300_000,
+        "generator_rectified",
+        "stops at its search range's bound",
     );
-    assert!(d.unexplained.is_some(), "{departure}: nothing said");
-    let row = d.row("generator_rectified").expect("a generator row");
-    assert!(
-        row.note.contains("stops at its search range's bound"),
-        "{}",
-        row.note
-    );
+    assert!(d.unexplained.is_some(), "nothing said");
 }
 
 /// An off-centre code disc (ε 9.3e-3 rad, its peak at φ 1.43 rad: the departure survey's draw 0
@@ -983,10 +977,11 @@ fn an_off_centre_code_disc_is_not_named_an_inertia_its_trajectories_put_within_t
 /// say the error follows θ (mod 2π).
 #[test]
 fn an_off_centre_code_disc_is_not_named_a_position_torque_on_the_equation_error_alone() {
-    let d = position_torque_refused(
+    let d = refused(
         "encoder_eccentricity",
         4,
         1_000_000,
+        "position_torque",
         "rests on the equation error alone",
     );
     let words = d.unexplained.as_deref().expect("`unexplained` said");
@@ -1002,10 +997,11 @@ fn an_off_centre_code_disc_is_not_named_a_position_torque_on_the_equation_error_
 /// words say the remaining torque follows dθ/dt and grows with time (t sgn θ̇).
 #[test]
 fn a_growing_dry_torque_is_not_named_a_position_torque_its_e_theta_confirms_at_another_size() {
-    let d = position_torque_refused(
+    let d = refused(
         "dry_torque_growth",
         4,
         1_100_000,
+        "position_torque",
         "at the refit's value but not at the screen's",
     );
     let words = d.unexplained.as_deref().expect("`unexplained` said");
@@ -1016,14 +1012,8 @@ fn a_growing_dry_torque_is_not_named_a_position_torque_its_e_theta_confirms_at_a
 }
 
 /// Runs the departure survey's campaign `k` of `name` (draws shifted by `off`) and checks that
-/// nothing is named and that the position torque's row gives `why` it was not; returns the
-/// discovery.
-fn position_torque_refused(
-    name: &str,
-    k: u64,
-    off: u64,
-    why: &str,
-) -> pendulum_discover::Discovery {
+/// nothing is named and that `effect`'s row gives `why` it was not; returns the discovery.
+fn refused(name: &str, k: u64, off: u64, effect: &str, why: &str) -> pendulum_discover::Discovery {
     let (seed, b, mu, departure) = drawn_departure(name, k, off);
     let d = discover_with(seed, b, mu, &departure).discovery;
     assert!(
@@ -1031,7 +1021,7 @@ fn position_torque_refused(
         "{departure}: named {:?}",
         d.accepted()
     );
-    let row = d.row("position_torque").expect("a position torque row");
+    let row = d.row(effect).unwrap_or_else(|| panic!("no {effect} row"));
     assert!(row.note.contains(why), "{}", row.note);
     d
 }
