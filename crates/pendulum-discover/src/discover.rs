@@ -1384,12 +1384,14 @@ fn speed_drift_row(
     row.refit_estimate = refit_est;
     // The track's value is inside the trajectories' interval when the profile through it (the
     // damping refitted with the drift held there) is not significantly worse than the refit.
-    let seg_x = substitution_segments(&traj2, &spec, &x_refit, &traj_ics2, false);
-    let screen_fits = traj_blind || {
+    // (Not where the trajectories cannot judge it: no view of theirs is asked then.)
+    let seg_x =
+        (!traj_blind).then(|| substitution_segments(&traj2, &spec, &x_refit, &traj_ics2, false));
+    let screen_fits = seg_x.as_ref().is_none_or(|seg_x| {
         let x_prof = refit_profile(&traj2, &spec, &x0, &traj_ics2, cfg.refit_evals, i_drift);
-        let (g, n) = trajectory_substitution(&traj2, &spec, &seg_x, &x_prof, &traj_ics2, false);
+        let (g, n) = trajectory_substitution(&traj2, &spec, seg_x, &x_prof, &traj_ics2, false);
         g >= -n
-    };
+    });
     // Two held-out views, as for a torque: the validate runs' E_θ, or their own accelerometer
     // (each run's crank track drifting as the identify runs' do) while E_θ falls at all. A
     // small drift barely moves the pendulum: a 3.4e-4 Hz/s drift, tracked within 0.01 %, was
@@ -1410,15 +1412,17 @@ fn speed_drift_row(
     let (sensor_gain, _, _) = sensor_heldout(&ev.val, 0.0, est);
     let tracks_confirm = sensor_gain > SENSOR_HELDOUT_GAIN;
     let mut without: Option<(f64, f64)> = None;
-    let felt = tracks_confirm && gain <= 0.0 && !traj_blind && {
-        let i = i_drift;
-        let mut start = x.clone();
-        start[i] = 0.0;
-        let x_zero = refit_profile(&traj2, &spec, &start, &traj_ics2, cfg.refit_evals, i);
-        let (g0, n0) = trajectory_substitution(&traj2, &spec, &seg_x, &x_zero, &traj_ics2, false);
-        without = Some((g0, n0));
-        g0 < -n0
-    };
+    let felt = tracks_confirm
+        && gain <= 0.0
+        && seg_x.as_ref().is_some_and(|seg_x| {
+            let mut start = x.clone();
+            start[i_drift] = 0.0;
+            let x_zero = refit_profile(&traj2, &spec, &start, &traj_ics2, cfg.refit_evals, i_drift);
+            let (g0, n0) =
+                trajectory_substitution(&traj2, &spec, seg_x, &x_zero, &traj_ics2, false);
+            without = Some((g0, n0));
+            g0 < -n0
+        });
     // And where the trajectories cannot judge it, a drift the tracks confirm is a fact about the
     // forcing, measured on every run, once it is material: it changes the crank's speed over an
     // identify run's forced segment by more than a tenth of the 1 % by which rig.md lets the
