@@ -1781,8 +1781,16 @@ struct PairLook {
     first_screen: Option<(f64, f64)>,
     /// Its held-out equation-error fall beside the second's column, and the bar it cleared.
     first_eq_beside: (f64, f64),
+    /// Where the first was held although the validate runs' own rows put its size elsewhere
+    /// ([`sizes_disagree`]; the other's unmodelled part biasing those rows): its screening
+    /// and the value it was screened at. Beside the second (applied exactly where it is a
+    /// sensor's), the identify and validate rows must then put its size at one value.
+    first_sizes: Option<(Screened, f64)>,
     /// The second candidate, judged beside the first.
     second: Screened,
+    /// Where the second stood in the queue saved in `state` (it is taken out of it), so that
+    /// if the pair is not confirmed it is judged alone where it would have been.
+    second_at: usize,
     /// The validation the first one's held-out gain was measured from (the model before the
     /// pair): the pair together must take its bar off that E_θ.
     before: Vec<RunFit>,
@@ -4089,6 +4097,8 @@ pub fn discover(
         // The pair look's second candidate, judged beside the first one held provisionally:
         // the first must not do better refitted away in the model holding both (its E_θ gain
         // beside the second, and the gain's noise).
+        // (The first's sizes beside the second, where they were asked: identify, validate.)
+        let mut first_sizes_beside = None;
         let pair_first = match pair.as_ref().filter(|_| accepted) {
             Some(p) => {
                 let i = pendulum_model::effects::by_name(&p.first)
@@ -4115,6 +4125,44 @@ pub fn discover(
                         let agrees = p
                             .first_screen
                             .is_none_or(|(e, h)| views_agree(e, h, refit_x[i], false));
+                        // A first held although the validate rows put its size elsewhere: beside
+                        // the second (the second's own columns, and its exact correction where it
+                        // has one), the two sets of rows must put it at one value.
+                        let beside = p.first_sizes.as_ref().map(|(f, f_est)| {
+                            let (v, corr) = refined
+                                .as_ref()
+                                .map_or((&view, &correction), |(v, c)| (v, c));
+                            let kind = pendulum_model::effects::by_name(&f.candidate.effect)
+                                .map_or(Kind::Dynamics, |e| e.kind());
+                            let mut with = cols.clone();
+                            with.extend(
+                                crate::weak::observation_column()
+                                    .filter(|o| kind != Kind::Observation && !cols.contains(o)),
+                            );
+                            let on = |rows: FitOn| {
+                                pooled_screen_estimate(
+                                    ctx,
+                                    &weak_ctx.alignments,
+                                    base,
+                                    &cfg.weak,
+                                    corr,
+                                    v,
+                                    &v.columns_from(&with, &view),
+                                    &f.candidate,
+                                    kind,
+                                    *f_est,
+                                    rows,
+                                )
+                            };
+                            on(FitOn::Identify).zip(on(FitOn::Validate))
+                        });
+                        first_sizes_beside = beside.flatten();
+                        let agrees = agrees
+                            && beside.is_none_or(|b| {
+                                b.is_some_and(|((e, s), (w, sw))| {
+                                    !sizes_disagree(e, 1.96 * s, w, 1.96 * sw)
+                                })
+                            });
                         Some((
                             g,
                             n,
@@ -4197,23 +4245,32 @@ pub fn discover(
             && !pair_tried
             && pair.is_none()
             && refused.is_none()
-            && ((plausible && !held_out) || pulled)
+            && ((plausible && (!held_out || size_disagrees)) || pulled)
             && excludes_zero
             && sc.delta_bic < cfg.screen_threshold
             && c.shaped().is_none()
             && size_absent.is_some()
             && round + 1 < cfg.max_effects
         {
+            // The next screened candidate that is another, unshaped effect: a shaped one
+            // (a position torque's k) screened between them is passed over. A hidden 0.042 rad
+            // encoder offset beside a 0.0131 kg·m² extra inertia on a drawn design (the
+            // every-effect survey's pair 2, `SURVEY_DAMPING=drawn SURVEY_SEED=11`) screened the
+            // inertia (ΔBIC −1636), a k = 1 position torque (−309, the offset's cos θ and the
+            // inertia's pull together) and the offset (−13.3); the inertia alone took
+            // 53.5 % ± 58.2 % off the validate runs' E_θ, the offset's refit alone said
+            // 5.9e-2 rad, and nothing was named.
             queue
-                .front()
-                .filter(|b| b.candidate.effect != c.effect && b.candidate.shaped().is_none())
-                .and_then(|b| {
+                .iter()
+                .enumerate()
+                .find(|(_, b)| b.candidate.effect != c.effect && b.candidate.shaped().is_none())
+                .and_then(|(at, b)| {
                     let fb = ols(&view.id_rows, &with_candidate(&current_cols, &b.candidate))?;
                     let fab = ols(&view.id_rows, &with_candidate(&cols, &b.candidate))?;
                     let (ga, na) = paired_gain(&view.sq_val(&fb), &view.sq_val(&fab));
                     let (gb, nb) = paired_gain(&view.sq_val(&fit), &view.sq_val(&fab));
                     let (bar_a, bar_b) = (cfg.eq_gain_min.max(na), cfg.eq_gain_min.max(nb));
-                    (ga > bar_a && gb > bar_b).then(|| (b.clone(), (ga, bar_a)))
+                    (ga > bar_a && gb > bar_b).then(|| (b.clone(), at, (ga, bar_a)))
                 })
         } else {
             None
@@ -4649,6 +4706,18 @@ pub fn discover(
             match pair_first.filter(|_| accepted) {
                 Some((g, n, without, gj, bar_j, (_, first_refit))) => {
                     if let Some((_, r)) = confirmed.iter_mut().find(|(e, _)| *e == p.first) {
+                        if let Some(((e, s), (w, sw))) =
+                            first_sizes_beside.filter(|_| p.first_sizes.is_some())
+                        {
+                            r.note.push_str(&format!(
+                                "; beside {}, the identify and validate runs' own rows put its size at one value: {e:.4e} [{:.4e}, {:.4e}] and {w:.4e} [{:.4e}, {:.4e}]",
+                                c.effect,
+                                e - 1.96 * s,
+                                e + 1.96 * s,
+                                w - 1.96 * sw,
+                                w + 1.96 * sw,
+                            ));
+                        }
                         if p.first_screen.is_some() {
                             r.note.push_str(&format!(
                                 "; in the model holding {} as well its trajectory refit is {first_refit:.4e}, which agrees with the screen",
@@ -4716,6 +4785,8 @@ pub fn discover(
                                     100.0 * bar_j,
                                     if agrees {
                                         String::new()
+                                    } else if p.first_sizes.is_some() {
+                                        "; beside it the validate runs' own rows still put its size elsewhere".to_string()
                                     } else {
                                         format!("; in the model holding both its trajectory refit, {first_refit:.4e}, still disagrees with the screen")
                                     }
@@ -4724,7 +4795,8 @@ pub fn discover(
                             }
                         ));
                     }
-                    next = Some(p.second);
+                    queue.insert(p.second_at, p.second);
+                    next = queue.pop_front();
                     continue;
                 }
             }
@@ -4740,14 +4812,25 @@ pub fn discover(
         if !accepted && !second_look && refused.is_none() {
             next = queue.pop_front();
         }
-        if let Some((b, eq)) = pair_start {
+        if let Some((b, at, eq)) = pair_start {
             let (v, corr, saved_cols) = pair_view.expect("taken with the pair look's start");
             pair_tried = true;
+            // The second is judged next, taken out of the queue where it stood (`next` holds
+            // the queue's front, popped above: it goes back unless it is the second).
+            if at > 0 {
+                if let Some(front) = next.take() {
+                    queue.push_front(front);
+                }
+                queue.remove(at);
+                next = Some(b.clone());
+            }
             pair = Some(PairLook {
                 first: c.effect.clone(),
                 first_screen: pulled.then_some((est, below_half.max(above_half))),
                 first_eq_beside: eq,
+                first_sizes: (size_disagrees && !pulled).then(|| (sc.clone(), est)),
                 second: b,
+                second_at: at,
                 before: before_val.clone(),
                 state: (
                     v,
