@@ -1886,33 +1886,12 @@ fn a_tilt_the_resting_pendulum_hides_from_the_equation_error_is_read_by_the_acce
 /// runs' zeros scatter over 12 mrad), and the pair look says so with the sizes beside.
 #[test]
 fn a_first_whose_sizes_the_others_absence_splits_is_named_in_a_pair() {
-    let off = 1_100_000;
-    let mut r = rng(3000 + 2 + off);
-    let (t_off, s_off, ..) = draw("encoder_offset", &mut r);
-    let (t_j, s_j, ..) = draw("extra_inertia", &mut r);
-    let s = discover(
-        7000 + 2 + off,
-        Base::Reference,
-        0.0,
-        0.5,
-        0.15,
-        &format!("{s_off}\n{s_j}"),
+    let (s, t_off) = offset_and_inertia_pair(1_100_000);
+    let off_est = s.discovery.row("encoder_offset").unwrap().estimate;
+    assert!(
+        (off_est / t_off - 1.0).abs() <= 0.10,
+        "offset {off_est:.4e} against {t_off:.4e}"
     );
-    let mut accepted = s.discovery.accepted();
-    accepted.sort_unstable();
-    assert_eq!(
-        accepted,
-        ["encoder_offset", "extra_inertia"],
-        "{:#?}",
-        s.discovery.rows
-    );
-    for (e, truth) in [("encoder_offset", t_off), ("extra_inertia", t_j)] {
-        let v = s.discovery.row(e).unwrap().estimate;
-        assert!(
-            (v / truth - 1.0).abs() <= 0.10,
-            "{e} {v:.4e} against {truth:.4e}"
-        );
-    }
     let note = &s.discovery.row("extra_inertia").unwrap().note;
     assert!(
         note.contains("named as a pair with encoder_offset")
@@ -1925,6 +1904,17 @@ fn a_first_whose_sizes_the_others_absence_splits_is_named_in_a_pair() {
 /// damping) at seed offset `off`: both named and nothing else, the offset within 2 mrad and the
 /// inertia within 10 %.
 fn offset_and_inertia_pair_is_named(off: u64) {
+    let (s, t_off) = offset_and_inertia_pair(off);
+    let off_est = s.discovery.row("encoder_offset").unwrap().estimate;
+    assert!(
+        (off_est - t_off).abs() <= 0.002,
+        "offset {off_est:.4e} against {t_off:.4e}"
+    );
+}
+
+/// The every-effect survey's pair 2 at seed offset `off`: both named and nothing else, the
+/// inertia within 10 %; the summary and the offset's truth.
+fn offset_and_inertia_pair(off: u64) -> (DiscoverSummary, f64) {
     let mut r = rng(3000 + 2 + off);
     let (t_off, s_off, ..) = draw("encoder_offset", &mut r);
     let (t_j, s_j, ..) = draw("extra_inertia", &mut r);
@@ -1944,16 +1934,12 @@ fn offset_and_inertia_pair_is_named(off: u64) {
         "{:#?}",
         s.discovery.rows
     );
-    let off_est = s.discovery.row("encoder_offset").unwrap().estimate;
-    assert!(
-        (off_est - t_off).abs() <= 0.002,
-        "offset {off_est:.4e} against {t_off:.4e}"
-    );
     let j = s.discovery.row("extra_inertia").unwrap().estimate;
     assert!(
         (j - t_j).abs() <= 0.10 * t_j,
         "inertia {j:.4e} against {t_j:.4e}"
     );
+    (s, t_off)
 }
 
 /// A 6.31e-3 N·m breakaway fading at 0.245 rad/s on a drawn design whose identify runs all rest
