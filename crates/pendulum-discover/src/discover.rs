@@ -3112,6 +3112,23 @@ pub fn discover(
     // screening while it waits, and its name (kept once it is judged again).
     let mut deferred: Option<Screened> = None;
     let mut deferred_effect: Option<String> = None;
+    // A pair look not confirmed: the search's state as its first one's refusal left it.
+    macro_rules! back_to_first_refusal {
+        ($p:expr) => {
+            (
+                view,
+                correction,
+                current,
+                current_val,
+                current_cols,
+                baseline,
+                round,
+                queue,
+                confirmed,
+                refused,
+            ) = $p.state
+        };
+    }
     loop {
         let sc = match next.take() {
             Some(sc) => sc,
@@ -3151,18 +3168,7 @@ pub fn discover(
                 // The pair look's second: back to where the first one's refusal left it, and
                 // the second judged alone where it stood.
                 Some(p) => {
-                    (
-                        view,
-                        correction,
-                        current,
-                        current_val,
-                        current_cols,
-                        baseline,
-                        round,
-                        queue,
-                        confirmed,
-                        refused,
-                    ) = p.state;
+                    back_to_first_refusal!(p);
                     queue.insert(p.second_at, p.second);
                     next = queue.pop_front();
                 }
@@ -4785,18 +4791,7 @@ pub fn discover(
                     }
                 }
                 None => {
-                    (
-                        view,
-                        correction,
-                        current,
-                        current_val,
-                        current_cols,
-                        baseline,
-                        round,
-                        queue,
-                        confirmed,
-                        refused,
-                    ) = p.state;
+                    back_to_first_refusal!(p);
                     if let Some((_, r)) = confirmed.iter_mut().find(|(e, _)| *e == p.first) {
                         r.note.push_str(&format!(
                             "; beside {}'s column the validate runs' equation error falls {:.1} % (needed > {:.1} %), but the pair is not confirmed ({}{})",
