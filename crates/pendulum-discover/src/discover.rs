@@ -8,11 +8,11 @@
 //!    trajectory error E_θ (initial states refitted for each model) falls by more than
 //!    max(`gain_min`, the held-out noise), or their equation error (coefficients from the
 //!    identify runs) falls by more than max(`eq_gain_min`, its held-out noise) while E_θ does not
-//!    rise by more than its noise. The noise of E_θ's fall is 1.96 × its standard error from the
-//!    paired differences of the validate runs' 0.5 s multiple-shooting segments (each restarts
-//!    from the measured state): a fall that the units' own scatter could produce by chance
-//!    (one-sided 2.5 %) is not a gain. The equation error's is 1.96 × the ratio estimator's
-//!    standard error over the weak-form windows ([`ratio_noise`]). (Sensor
+//!    rise by more than its noise. The noise of a fall is 1.96 × its standard error from the
+//!    paired differences of its units: the 0.5 s multiple-shooting segments of the validate runs
+//!    for E_θ (each restarts from the measured state), the weak-form windows for the equation
+//!    error. A fall that the units' own scatter could produce by chance (one-sided 2.5 %) is not
+//!    a gain. (Sensor
 //!    effects such as an accelerometer lag move E_θ on 0.5 s segments very little but the
 //!    equation error a lot.) A second effect, added to a model already extended, is judged the
 //!    same way against that model.
