@@ -2532,11 +2532,6 @@ fn eq_reach(rows: &[WeakRow], fit: &crate::screen::Ols, current: &[usize], after
 /// significant −74 % ± 1.7 %), and the surveys lost more campaigns than they gained (first
 /// draws +1, other draws −1, third draws −2 in their first 25, one departure's `unexplained`).
 /// Changing it means giving those bars their own null noise and a floor for runs at rest.
-///
-/// (The equation error's bar, for a fall that confirms a candidate and for a rise that leans
-/// against one, is [`ratio_noise`]'s since the fifty-first session, on the validate runs'
-/// weak-form windows alone: E_θ's bars, and the rise that rejects an impossible value, keep
-/// this one.)
 pub(crate) fn paired_gain(before: &[f64], after: &[f64]) -> (f64, f64) {
     let n = before.len().min(after.len());
     let sb: f64 = before[..n].iter().sum();
@@ -2549,21 +2544,6 @@ pub(crate) fn paired_gain(before: &[f64], after: &[f64]) -> (f64, f64) {
     let mean = d.iter().sum::<f64>() / n as f64;
     let var = d.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n as f64 - 1.0);
     (gain, HELDOUT_Z * (n as f64 * var).sqrt() / sb.max(1e-300))
-}
-
-/// The sampling error of the fall 1 − Σafter/Σbefore over paired units, z × the ratio
-/// estimator's standard error: the spread of each unit's after-value about the common ratio
-/// times its before-value, sqrt(n/(n − 1) · Σ(aᵢ − R bᵢ)²) / Σb with R = Σa/Σb (the delta method;
-/// the bootstrap over units reproduces it). Infinite with fewer than three units.
-pub(crate) fn ratio_noise(before: &[f64], after: &[f64]) -> f64 {
-    let n = before.len().min(after.len());
-    if n < 3 {
-        return f64::INFINITY;
-    }
-    let sb: f64 = before[..n].iter().sum();
-    let r = after[..n].iter().sum::<f64>() / sb.max(1e-300);
-    let ss: f64 = (0..n).map(|i| (after[i] - r * before[i]).powi(2)).sum();
-    HELDOUT_Z * (ss * n as f64 / (n as f64 - 1.0)).sqrt() / sb.max(1e-300)
 }
 
 /// Paired units of two validations of the same runs: their multiple-shooting segments, which
@@ -3573,26 +3553,15 @@ pub fn discover(
             heldout_gain(&before_judged, &val_judged)
         };
         let gain_needed = cfg.gain_min.max(noise);
-        // (The fall, the paired differences' noise, the ratio estimator's, and the reach.)
-        let (eq_gain, eq_noise, eq_ratio_noise, reach) = match ols(&view.id_rows, &current_cols) {
+        let (eq_gain, eq_noise, reach) = match ols(&view.id_rows, &current_cols) {
             Some(f0) => {
-                let (before, after) = (view.sq_val(&f0), view.sq_val(&fit));
-                let (g, n) = paired_gain(&before, &after);
-                let reach = eq_reach(&view.val_rows, &fit, &current_cols, &after);
-                (g, n, ratio_noise(&before, &after), reach)
+                let after = view.sq_val(&fit);
+                let (g, n) = paired_gain(&view.sq_val(&f0), &after);
+                (g, n, eq_reach(&view.val_rows, &fit, &current_cols, &after))
             }
-            None => (f64::NAN, f64::INFINITY, f64::INFINITY, 0.0),
+            None => (f64::NAN, f64::INFINITY, 0.0),
         };
-        // The bar an equation-error fall must clear is its own sampling error, the ratio
-        // estimator's ([`ratio_noise`]), not the null's spread of the paired differences that
-        // E_θ keeps: a window's error grows with the torque the model misses there (a lag's with
-        // the forcing on a chaotic run), and a fall that every window shows in proportion is not
-        // one the largest windows could make by chance. A hidden 4.06 ms lag (`SURVEY_DAMPING=drawn
-        // SURVEY_SEED=15`, `accel_delay` k=0; screened at 4.053 ms, ΔBIC −982, refitted at 4.036,
-        // the validate runs' E_θ unable to see it) took 87.1 % off the validate runs' equation
-        // error, falling in 48 of 67 windows, one of which held 46 % of the sum: judged against
-        // the paired differences' 92.4 % it was refused; the ratio estimator's noise is 13.2 %.
-        let eq_needed = cfg.eq_gain_min.max(eq_ratio_noise);
+        let eq_needed = cfg.eq_gain_min.max(eq_noise);
         // Whether the validate runs' equation error could see the candidate at all: the fall it
         // would show were the candidate true at the identify runs' size ([`eq_reach`])
         // beyond the bar a fall must clear. A view that could not see it neither confirms it
@@ -5425,20 +5394,6 @@ mod tests {
         // A uniform fall has no scatter; two units cannot be judged.
         assert_eq!(paired_gain(&[1.0; 5], &[0.9; 5]).1, 0.0);
         assert!(paired_gain(&[1.0, 2.0], &[0.5, 1.0]).1.is_infinite());
-    }
-    /// The ratio estimator's noise by hand, and its point: a fall every unit shows in proportion
-    /// has none, however unequal the units, while the paired differences' spread is large.
-    #[test]
-    fn ratio_noise_matches_hand_computation() {
-        let before = [1.0, 2.0, 3.0, 4.0];
-        let after = [0.5, 1.5, 3.0, 3.0];
-        // R = 8/10; residuals a − R b = [−0.3, −0.1, 0.6, −0.2], Σ² = 0.5.
-        let want = 1.96 * (0.5_f64 * 4.0 / 3.0).sqrt() / 10.0;
-        assert!((ratio_noise(&before, &after) - want).abs() < 1e-15);
-        let (big, small) = ([100.0, 1.0, 1.0, 1.0], [10.0, 0.1, 0.1, 0.1]);
-        assert!(ratio_noise(&big, &small) < 1e-12);
-        assert!(paired_gain(&big, &small).1 > 0.5);
-        assert!(ratio_noise(&[1.0, 2.0], &[0.5, 1.0]).is_infinite());
     }
     /// Two sets of runs disagree on a size only when their intervals are apart and the values
     /// more than the promised 10 % apart: a bouncing bob's 7.18e-3 against 2.48e-2 kg·m² do;
