@@ -1355,16 +1355,6 @@ fn speed_drift_row(
     // −6.7e-4 and named.
     let (traj2, traj_ics2) = moving_runs(&id2, &ics2, false);
     let (x_refit, f, traj2) = refit_zeroed_on(&traj2, &spec, &x0, &traj_ics2, cfg.refit_evals);
-    // Where no identify run leaves rest, their trajectories cannot judge the drift: a resting
-    // pendulum's error under the shaker is its quantised rest angle, which no crank speed
-    // moves. Nor where their refit stops at an end of its search range: the bound set it, not
-    // the data. Their refit then says nothing (nor does it disagree), and the model judged on
-    // the held-out runs carries the tracks' value, the damping refitted with it held there. A
-    // 1.20e-3 Hz/s drift tracked within 0.02 % on a drawn design whose identify runs all rest
-    // (`SURVEY_DAMPING=drawn SURVEY_SEED=11`, `speed_drift` k=0) was refitted to −1.0e-2, the
-    // end of its search range, and the model carrying that value scored 60 % worse on the
-    // validate runs; a 1.02e-3 Hz/s one (k=4), its identify runs all coming to rest, was
-    // refitted there too and refused as the two views disagreeing.
     let i_drift = spec.params.len() - 1;
     // The profile through the tracks' value: the damping refitted with the drift held there.
     let x_track = refit_profile(&traj2, &spec, &x0, &traj_ics2, cfg.refit_evals, i_drift);
