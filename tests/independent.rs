@@ -334,6 +334,52 @@ fn survey_independent_campaigns_redesigned() {
     assert!(wrong.is_empty(), "{wrong:#?}");
 }
 
+/// `i01_none_quadratic` (quadratic drag a = 0.08 kg/m and bearing friction μ = 0.17 in its
+/// truth) with `--base linear`, the study's model: both terms are missing from it, and each alone
+/// is a partial explanation of their sum (the drag alone was refused because the bearing's shape
+/// beside it did better, and that refusal ended the search with nothing named). The pair look
+/// now starts from a partial explanation: both are named, each at its value beside the other.
+#[test]
+fn issue_12_independent_i01_with_the_linear_base_names_the_drag_and_the_bearing_friction() {
+    let Some(root) = independent_dir() else {
+        eprintln!(
+            "SKIPPED: ../shared/data/independent is absent (issue 12's independent campaigns)"
+        );
+        return;
+    };
+    let name = "i01_none_quadratic";
+    let truth = truth_of(&root, name);
+    let out = tempfile::tempdir().unwrap();
+    let s = run(&DiscoverJob {
+        input: root.join(name),
+        out: out.path().join("out"),
+        base: Base::Linear,
+        pipeline: None,
+        generations: None,
+        seed: None,
+        progress: false,
+    })
+    .unwrap();
+    eprintln!("{s}");
+    let accepted: BTreeSet<String> = s
+        .discovery
+        .accepted()
+        .into_iter()
+        .map(String::from)
+        .collect();
+    assert_eq!(accepted, expected(&truth, Base::Linear));
+    for (effect, key) in [("viscous_quadratic", "a"), ("coulomb_bearing", "mu")] {
+        let want = truth["model"][key].as_f64().unwrap();
+        let row = s.discovery.row(effect).unwrap();
+        assert!(
+            (row.estimate - want).abs() <= 0.10 * want,
+            "{effect}: {} against the truth's {key} = {want}; {}",
+            row.estimate,
+            row.note
+        );
+    }
+}
+
 macro_rules! independent {
     ($($test:ident: $name:literal, $base:expr;)*) => {$(
         #[test]

@@ -45,7 +45,8 @@ use crate::weak::{weak_rows, WeakConfig, WeakRow};
 pub struct DiscoverConfig {
     /// ΔBIC a candidate must beat in the screen.
     pub screen_threshold: f64,
-    /// Most effects added on top of the base.
+    /// Most effects added on top of the reference model; a base that leaves out some of its
+    /// terms may add those as well ([`Base::left_out`]).
     pub max_effects: usize,
     /// Smallest fall of the validate runs' trajectory E_θ (the paired held-out noise, if larger).
     pub gain_min: f64,
@@ -1787,6 +1788,10 @@ const WEIGHT_FIT_MAX_GROUP: u32 = 4;
 struct PairLook {
     /// The first candidate, held provisionally.
     first: String,
+    /// Where the first was refused alone as a partial explanation (a freer shape did better):
+    /// its candidate, whose size is then read again beside the second (alone it took up part of
+    /// the other's torque).
+    first_partial: Option<Candidate>,
     /// Where the first was held although its own trajectory refit disagreed with its screen
     /// (the other's unmodelled part pulling that refit): its screen value and the half-width
     /// the agreement allows ([`views_agree`]). In the model holding both, its refitted size
@@ -2988,13 +2993,16 @@ pub fn discover(
     })?;
     let residual_base = base_ols.residuals(&view0.weak);
 
-    // Screen.
+    // Screen. A base without some of the reference's terms may have to name those besides the
+    // hidden effects: `i10_pair` (a position torque and an inertia on a rig with bearing
+    // friction) with `--base linear` named the pair and stopped at two, the friction unnamed.
+    let max_effects = cfg.max_effects + base.left_out();
     let screened = stepwise(
         &view0.id_rows,
         base,
         &zero_cols,
         cfg.screen_threshold,
-        cfg.max_effects,
+        max_effects,
     );
     let first_round = &screened.first_round;
 
@@ -3199,7 +3207,11 @@ pub fn discover(
                 Some(p) => {
                     back_to_first_refusal!(p);
                     queue.insert(p.second_at, p.second);
-                    next = queue.pop_front();
+                    next = if refused.is_none() {
+                        queue.pop_front()
+                    } else {
+                        None
+                    };
                 }
                 None if !second_look => next = queue.pop_front(),
                 None => {}
@@ -4312,18 +4324,32 @@ pub fn discover(
         // 70 % ± 19 % off the validate runs' E_θ and 98.8 % off their equation error, but its
         // refit, with the dry torque's work left to μ and the tilt, said 2.81e-2.
         let pulled = plausible_but_agree && !agree && !refit_pinned && held_out;
+        // Or a partial explanation whose freer shape the next screened candidate may complete:
+        // where the base leaves out two terms the rig has, each alone is a partial explanation
+        // of their sum. `i01_none_quadratic` (quadratic drag a = 0.08 kg/m, bearing friction
+        // μ = 0.17) with `--base linear` screened the drag (ΔBIC −1691) and the bearing friction
+        // (−1324) and named neither: the drag alone was refused because θ̇|θ̇| + θ̇ + sgn θ̇ cos θ
+        // + sgn θ̇ (the bearing's shape beside it) did better, and its refusal ended the
+        // search. Held provisionally, the second is judged beside it by every check, the
+        // freer-shape comparison with both in among them, and where its own trajectory refit
+        // disagreed with its screen (the other's work pulling it), its size in the model holding
+        // both must agree with that screen, as for `pulled`. (Whatever the runs' own damping
+        // factors said with it alone: the drag alone left the bearing's share, which differs by
+        // bob, to each run's factor; the second is judged by that check with both in.)
+        let partial_start =
+            partial.is_some() && !angle_remains && significant && possible && !refit_pinned;
         let pair_start = if !accepted
             && !held_back
             && !second_look
             && !pair_tried
             && pair.is_none()
             && refused.is_none()
-            && ((plausible && (!held_out || size_disagrees)) || pulled)
+            && ((plausible && (!held_out || size_disagrees)) || pulled || partial_start)
             && excludes_zero
             && sc.delta_bic < cfg.screen_threshold
             && c.shaped().is_none()
             && size_absent.is_some()
-            && round + 1 < cfg.max_effects
+            && round + 1 < max_effects
         {
             // The next screened candidate that is another, unshaped effect: a shaped one
             // (a position torque's k) screened between them is passed over. A hidden 0.042 rad
@@ -4801,7 +4827,9 @@ pub fn discover(
                         r.note.push_str(&format!(
                             "; named as a pair with {}: alone, the other's unmodelled part spoiled its {} (the figures above); beside {}'s column the validate runs' equation error falls {:.1} % (needed > {:.1} %), in the model holding both its size refitted to 0 (the other terms refitted) does not do better on the validate runs' E_θ (gain {:.3}, noise {:.3}), and the pair together takes {:.1} % off the validate runs' E_θ (needed > {:.1} %)",
                             c.effect,
-                            if p.first_screen.is_some() {
+                            if p.first_partial.is_some() {
+                                "comparison with a freer shape (it made it a partial explanation)"
+                            } else if p.first_screen.is_some() {
                                 "trajectory refit"
                             } else {
                                 "held-out views"
@@ -4814,6 +4842,26 @@ pub fn discover(
                             100.0 * gj,
                             100.0 * bar_j,
                         ));
+                        // A partial explanation's size alone held part of the other's torque
+                        // (the drag's 0.127 kg/m beside a missing bearing friction, 0.080 with
+                        // it): its value is the one beside the second.
+                        if let Some(fc) = &p.first_partial {
+                            let (e, se, unit) = to_si(fc, &fit);
+                            if e.is_finite() && se.is_finite() {
+                                r.note.push_str(&format!(
+                                    "; beside {}, the identify runs' equation error puts its size at {e:.4e} [{:.4e}, {:.4e}] {unit} and its trajectory refit in the model holding both at {first_refit:.4e} (the values reported; the figures above are its own, alone)",
+                                    c.effect,
+                                    e - 1.96 * se,
+                                    e + 1.96 * se,
+                                ));
+                                r.estimate = e;
+                                r.identify_estimate = e;
+                                r.screen_estimate = e;
+                                r.ci_low = e - 1.96 * se;
+                                r.ci_high = e + 1.96 * se;
+                                r.refit_estimate = first_refit;
+                            }
+                        }
                         r.accepted = true;
                         r.heldout_eq_gain = ga;
                         r.heldout_gain = g;
@@ -4858,7 +4906,12 @@ pub fn discover(
                         ));
                     }
                     queue.insert(p.second_at, p.second);
-                    next = queue.pop_front();
+                    // As the first's refusal left it: a refusal ends the search's round.
+                    next = if refused.is_none() {
+                        queue.pop_front()
+                    } else {
+                        None
+                    };
                     continue;
                 }
             }
@@ -4878,8 +4931,9 @@ pub fn discover(
             let (v, corr, saved_cols) = pair_view.expect("taken with the pair look's start");
             pair_tried = true;
             // The second is judged next, taken out of the queue where it stood (`next` holds
-            // the queue's front, popped above: it goes back unless it is the second).
-            if at > 0 {
+            // the queue's front, popped above: it goes back unless it is the second; a first
+            // refused as a partial explanation popped nothing, its refusal ending the search).
+            if at > 0 || next.is_none() {
                 if let Some(front) = next.take() {
                     queue.push_front(front);
                 }
@@ -4888,7 +4942,9 @@ pub fn discover(
             }
             pair = Some(PairLook {
                 first: c.effect.clone(),
-                first_screen: pulled.then_some((est, below_half.max(above_half))),
+                first_partial: partial.is_some().then(|| c.clone()),
+                first_screen: (pulled || (partial_start && !agree))
+                    .then_some((est, below_half.max(above_half))),
                 first_eq_beside: eq,
                 first_sizes: (size_disagrees && !pulled).then(|| (sc.clone(), est)),
                 second: b,
@@ -4907,6 +4963,9 @@ pub fn discover(
                     refused.clone(),
                 ),
             });
+            // A partial explanation's refusal stands only if the pair is not named (the state
+            // above returns it).
+            refused = None;
         }
         if accepted && second_look {
             // The look's accepted effect supersedes the first round's refusal (see above).
@@ -4919,7 +4978,7 @@ pub fn discover(
             baseline = [None, None, None, None];
             round += 1;
             // (Not while a pair look's first candidate is held: its second is judged next.)
-            if round < cfg.max_effects && pair.is_none() {
+            if round < max_effects && pair.is_none() {
                 // Re-screen what is left (on the corrected view, if one was built).
                 let sw = stepwise_from(&view.id_rows, base, &current_cols, cfg.screen_threshold, 1);
                 current_cols.extend(sw.nuisance.iter().copied());

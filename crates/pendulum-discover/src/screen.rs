@@ -43,6 +43,13 @@ impl Base {
         }
     }
 
+    /// How many of the reference model's terms it leaves out: each is one more effect a
+    /// search from it may have to name (`--base linear` on a rig with quadratic drag, bearing
+    /// friction and two hidden effects has four to find).
+    pub fn left_out(self) -> usize {
+        Base::Reference.effects().len() - self.effects().len()
+    }
+
     /// Column indices of the base's own terms.
     pub fn columns(self) -> Vec<usize> {
         self.effects().iter().filter_map(|e| column_of(e)).collect()
