@@ -1808,7 +1808,7 @@ struct PairLook {
     second: Screened,
     /// Where the second stood in the queue saved in `state` (it is taken out of it), so that
     /// if the pair is not confirmed it is judged alone where it would have been.
-    second_at: usize,
+    second_at: Option<usize>,
     /// The validation the first one's held-out gain was measured from (the model before the
     /// pair): the pair together must take its bar off that E_θ.
     before: Vec<RunFit>,
@@ -3145,6 +3145,9 @@ pub fn discover(
     // The pair look (see [`PairLook`]): set while its first candidate is held provisionally.
     let mut pair: Option<PairLook> = None;
     let mut pair_tried = false;
+    // The unshaped candidates this round refused on the screen's route (a partial
+    // explanation's possible partners).
+    let mut round_refused: Vec<Screened> = Vec::new();
     // The candidate held back in the first round (see `held_back`), once per campaign: its
     // screening while it waits, and its name (kept once it is judged again).
     let mut deferred: Option<Screened> = None;
@@ -3188,6 +3191,7 @@ pub fn discover(
             },
         };
         let second_look = !matches!(second, SecondLook::NotStarted);
+        let judging_pair_second = pair.is_some();
         let c = &sc.candidate;
         let mut cols = with_candidate(&current_cols, c);
         if let Some(sh) = c.shaped() {
@@ -3206,7 +3210,9 @@ pub fn discover(
                 // the second judged alone where it stood.
                 Some(p) => {
                     back_to_first_refusal!(p);
-                    queue.insert(p.second_at, p.second);
+                    if let Some(at) = p.second_at {
+                        queue.insert(at, p.second);
+                    }
                     next = if refused.is_none() {
                         queue.pop_front()
                     } else {
@@ -4359,17 +4365,35 @@ pub fn discover(
             // inertia's pull together) and the offset (−13.3); the inertia alone took
             // 53.5 % ± 58.2 % off the validate runs' E_θ, the offset's refit alone said
             // 5.9e-2 rad, and nothing was named.
+            let beside = |b: &Screened| {
+                let fb = ols(&view.id_rows, &with_candidate(&current_cols, &b.candidate))?;
+                let fab = ols(&view.id_rows, &with_candidate(&cols, &b.candidate))?;
+                let (ga, na) = paired_gain(&view.sq_val(&fb), &view.sq_val(&fab));
+                let (gb, nb) = paired_gain(&view.sq_val(&fit), &view.sq_val(&fab));
+                let (bar_a, bar_b) = (cfg.eq_gain_min.max(na), cfg.eq_gain_min.max(nb));
+                (ga > bar_a && gb > bar_b).then_some((ga, bar_a))
+            };
+            let partner =
+                |b: &&Screened| b.candidate.effect != c.effect && b.candidate.shaped().is_none();
+            // A partial explanation's partner may also be one this round refused before it:
+            // the term that completes it can be judged first, and alone it is a partial
+            // explanation too (the drag and the bearing friction under `--base linear`, the
+            // friction screened first and refused because the runs still disagreed on the
+            // damping). Asked only where the queue's next does not complete it.
             queue
                 .iter()
                 .enumerate()
-                .find(|(_, b)| b.candidate.effect != c.effect && b.candidate.shaped().is_none())
-                .and_then(|(at, b)| {
-                    let fb = ols(&view.id_rows, &with_candidate(&current_cols, &b.candidate))?;
-                    let fab = ols(&view.id_rows, &with_candidate(&cols, &b.candidate))?;
-                    let (ga, na) = paired_gain(&view.sq_val(&fb), &view.sq_val(&fab));
-                    let (gb, nb) = paired_gain(&view.sq_val(&fit), &view.sq_val(&fab));
-                    let (bar_a, bar_b) = (cfg.eq_gain_min.max(na), cfg.eq_gain_min.max(nb));
-                    (ga > bar_a && gb > bar_b).then(|| (b.clone(), at, (ga, bar_a)))
+                .find(|(_, b)| partner(b))
+                .and_then(|(at, b)| beside(b).map(|eq| (b.clone(), Some(at), eq)))
+                .or_else(|| {
+                    partial_start
+                        .then(|| {
+                            round_refused
+                                .iter()
+                                .filter(partner)
+                                .find_map(|b| beside(b).map(|eq| (b.clone(), None, eq)))
+                        })
+                        .flatten()
                 })
         } else {
             None
@@ -4905,7 +4929,9 @@ pub fn discover(
                             }
                         ));
                     }
-                    queue.insert(p.second_at, p.second);
+                    if let Some(at) = p.second_at {
+                        queue.insert(at, p.second);
+                    }
                     // As the first's refusal left it: a refusal ends the search's round.
                     next = if refused.is_none() {
                         queue.pop_front()
@@ -4915,6 +4941,14 @@ pub fn discover(
                     continue;
                 }
             }
+        }
+        if !accepted
+            && !second_look
+            && !judging_pair_second
+            && pair_start.is_none()
+            && c.shaped().is_none()
+        {
+            round_refused.push(sc.clone());
         }
         if held_back {
             deferred = Some(sc.clone());
@@ -4933,12 +4967,22 @@ pub fn discover(
             // The second is judged next, taken out of the queue where it stood (`next` holds
             // the queue's front, popped above: it goes back unless it is the second; a first
             // refused as a partial explanation popped nothing, its refusal ending the search).
-            if at > 0 || next.is_none() {
-                if let Some(front) = next.take() {
-                    queue.push_front(front);
+            match at {
+                Some(at) if at > 0 || next.is_none() => {
+                    if let Some(front) = next.take() {
+                        queue.push_front(front);
+                    }
+                    queue.remove(at);
+                    next = Some(b.clone());
                 }
-                queue.remove(at);
-                next = Some(b.clone());
+                Some(_) => {}
+                // One this round refused before: judged again, beside the first.
+                None => {
+                    if let Some(front) = next.take() {
+                        queue.push_front(front);
+                    }
+                    next = Some(b.clone());
+                }
             }
             pair = Some(PairLook {
                 first: c.effect.clone(),
@@ -4973,6 +5017,7 @@ pub fn discover(
         }
         if take {
             current = taken(&current, &id_runs, spec.clone(), x.clone(), &ics);
+            round_refused.clear();
             current_val = val;
             current_cols = cols;
             baseline = [None, None, None, None];
