@@ -1788,7 +1788,8 @@ const WEIGHT_FIT_MAX_GROUP: u32 = 4;
 struct PairLook {
     /// The first candidate, held provisionally.
     first: String,
-    /// Where the first was refused alone as a partial explanation (a freer shape did better):
+    /// Where the first was refused alone as a partial explanation (a freer shape did better, or
+    /// the runs' own damping factors still disagreed with it in):
     /// its candidate, whose size is then read again beside the second (alone it took up part of
     /// the other's torque).
     first_partial: Option<Candidate>,
@@ -4330,7 +4331,8 @@ pub fn discover(
         // 70 % ± 19 % off the validate runs' E_θ and 98.8 % off their equation error, but its
         // refit, with the dry torque's work left to μ and the tilt, said 2.81e-2.
         let pulled = plausible_but_agree && !agree && !refit_pinned && held_out;
-        // Or a partial explanation whose freer shape the next screened candidate may complete:
+        // Or a partial explanation (a freer shape does better, or the runs' own damping factors
+        // still disagree with it in) that the next screened candidate may complete:
         // where the base leaves out two terms the rig has, each alone is a partial explanation
         // of their sum. `i01_none_quadratic` (quadratic drag a = 0.08 kg/m, bearing friction
         // μ = 0.17) with `--base linear` screened the drag (ΔBIC −1691) and the bearing friction
@@ -4339,11 +4341,16 @@ pub fn discover(
         // search. Held provisionally, the second is judged beside it by every check, the
         // freer-shape comparison with both in among them, and where its own trajectory refit
         // disagreed with its screen (the other's work pulling it), its size in the model holding
-        // both must agree with that screen, as for `pulled`. (Whatever the runs' own damping
-        // factors said with it alone: the drag alone left the bearing's share, which differs by
-        // bob, to each run's factor; the second is judged by that check with both in.)
-        let partial_start =
-            partial.is_some() && !angle_remains && significant && possible && !refit_pinned;
+        // both must agree with that screen, as for `pulled`. The drag alone also leaves the
+        // bearing's share, which differs by bob, to each run's own damping factor: on a drawn
+        // twin design with a = 0.08 kg/m, μ = 0.15 and `--base linear` the drag was refused on
+        // those factors alone, and nothing was named (now 0.0800 and 0.150). The second is
+        // judged by that check with both in.
+        let partial_start = (partial.is_some() || runs_disagree)
+            && !angle_remains
+            && significant
+            && possible
+            && !refit_pinned;
         let pair_start = if !accepted
             && !held_back
             && !second_look
@@ -4852,7 +4859,7 @@ pub fn discover(
                             "; named as a pair with {}: alone, the other's unmodelled part spoiled its {} (the figures above); beside {}'s column the validate runs' equation error falls {:.1} % (needed > {:.1} %), in the model holding both its size refitted to 0 (the other terms refitted) does not do better on the validate runs' E_θ (gain {:.3}, noise {:.3}), and the pair together takes {:.1} % off the validate runs' E_θ (needed > {:.1} %)",
                             c.effect,
                             if p.first_partial.is_some() {
-                                "comparison with a freer shape (it made it a partial explanation)"
+                                "judgement as a whole explanation (alone it was a partial one)"
                             } else if p.first_screen.is_some() {
                                 "trajectory refit"
                             } else {
@@ -4986,7 +4993,7 @@ pub fn discover(
             }
             pair = Some(PairLook {
                 first: c.effect.clone(),
-                first_partial: partial.is_some().then(|| c.clone()),
+                first_partial: partial_start.then(|| c.clone()),
                 first_screen: (pulled || (partial_start && !agree))
                     .then_some((est, below_half.max(above_half))),
                 first_eq_beside: eq,
