@@ -1789,9 +1789,8 @@ struct PairLook {
     /// The first candidate, held provisionally.
     first: String,
     /// Where the first was refused alone as a partial explanation (a freer shape did better, or
-    /// the runs' own damping factors still disagreed with it in):
-    /// its candidate, whose size is then read again beside the second (alone it took up part of
-    /// the other's torque).
+    /// the runs' own damping factors still disagreed with it in): its candidate, whose size is
+    /// then read again beside the second (alone it took up part of the other's torque).
     first_partial: Option<Candidate>,
     /// Where the first was held although its own trajectory refit disagreed with its screen
     /// (the other's unmodelled part pulling that refit): its screen value and the half-width
@@ -4973,7 +4972,7 @@ pub fn discover(
             pair_tried = true;
             // The second is judged next, taken out of the queue where it stood (`next` holds
             // the queue's front, popped above: it goes back unless it is the second; a first
-            // refused as a partial explanation popped nothing, its refusal ending the search).
+            // whose refusal would end the search popped nothing).
             match at {
                 Some(at) if at > 0 || next.is_none() => {
                     if let Some(front) = next.take() {
