@@ -87,9 +87,12 @@ fn truth_of(root: &Path, name: &str) -> serde_json::Value {
         .unwrap()
 }
 
-/// Runs `discover` on the campaign in `dir` and applies the README's rule: `Err` says what was
-/// wrong (the accepted set, or an estimate outside its tolerance).
-fn judge(dir: &Path, truth: &serde_json::Value, base: Base) -> Result<(), String> {
+/// Runs `discover` on the campaign in `dir` with `base` (defaults otherwise, outputs in a
+/// temporary folder): its summary and the effects it accepted.
+fn discover_on(
+    dir: &Path,
+    base: Base,
+) -> (pendulum_jobs::discover::DiscoverSummary, BTreeSet<String>) {
     let out = tempfile::tempdir().unwrap();
     let s = run(&DiscoverJob {
         input: dir.to_path_buf(),
@@ -102,12 +105,19 @@ fn judge(dir: &Path, truth: &serde_json::Value, base: Base) -> Result<(), String
     })
     .unwrap();
     eprintln!("{s}");
-    let accepted: BTreeSet<String> = s
+    let accepted = s
         .discovery
         .accepted()
         .into_iter()
         .map(String::from)
         .collect();
+    (s, accepted)
+}
+
+/// Runs `discover` on the campaign in `dir` and applies the README's rule: `Err` says what was
+/// wrong (the accepted set, or an estimate outside its tolerance).
+fn judge(dir: &Path, truth: &serde_json::Value, base: Base) -> Result<(), String> {
+    let (s, accepted) = discover_on(dir, base);
     let want = expected(truth, base);
     if accepted != want {
         return Err(format!("accepted {accepted:?}, expected {want:?}"));
@@ -349,24 +359,7 @@ fn issue_12_independent_i01_with_the_linear_base_names_the_drag_and_the_bearing_
     };
     let name = "i01_none_quadratic";
     let truth = truth_of(&root, name);
-    let out = tempfile::tempdir().unwrap();
-    let s = run(&DiscoverJob {
-        input: root.join(name),
-        out: out.path().join("out"),
-        base: Base::Linear,
-        pipeline: None,
-        generations: None,
-        seed: None,
-        progress: false,
-    })
-    .unwrap();
-    eprintln!("{s}");
-    let accepted: BTreeSet<String> = s
-        .discovery
-        .accepted()
-        .into_iter()
-        .map(String::from)
-        .collect();
+    let (s, accepted) = discover_on(&root.join(name), Base::Linear);
     assert_eq!(accepted, expected(&truth, Base::Linear));
     for (effect, key) in [("viscous_quadratic", "a"), ("coulomb_bearing", "mu")] {
         let want = truth["model"][key].as_f64().unwrap();

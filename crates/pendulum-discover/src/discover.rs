@@ -3169,6 +3169,20 @@ pub fn discover(
             ) = $p.state
         };
     }
+    // ... and the second judged alone where it stood in the queue (if it stood there), unless the
+    // first's refusal ended the search's round.
+    macro_rules! requeue_second {
+        ($p:expr) => {
+            if let Some(at) = $p.second_at {
+                queue.insert(at, $p.second);
+            }
+            next = if refused.is_none() {
+                queue.pop_front()
+            } else {
+                None
+            };
+        };
+    }
     loop {
         let sc = match next.take() {
             Some(sc) => sc,
@@ -3210,14 +3224,7 @@ pub fn discover(
                 // the second judged alone where it stood.
                 Some(p) => {
                     back_to_first_refusal!(p);
-                    if let Some(at) = p.second_at {
-                        queue.insert(at, p.second);
-                    }
-                    next = if refused.is_none() {
-                        queue.pop_front()
-                    } else {
-                        None
-                    };
+                    requeue_second!(p);
                 }
                 None if !second_look => next = queue.pop_front(),
                 None => {}
@@ -4935,15 +4942,7 @@ pub fn discover(
                             }
                         ));
                     }
-                    if let Some(at) = p.second_at {
-                        queue.insert(at, p.second);
-                    }
-                    // As the first's refusal left it: a refusal ends the search's round.
-                    next = if refused.is_none() {
-                        queue.pop_front()
-                    } else {
-                        None
-                    };
+                    requeue_second!(p);
                     continue;
                 }
             }
