@@ -11,4 +11,4 @@ mod stats;
 pub use error::NumericsError;
 pub use ls::{inverse_spd, ols, solve_spd, wls, LsFit};
 pub use misc::{golden_section, median, trapezoid, trapezoid_weight, wrap_pi, Golden};
-pub use stats::{bic, f_sf, normal_quantile, normal_sf, t_quantile};
+pub use stats::{bic, f_sf, normal_quantile, normal_sf, signed_rank_z, t_quantile};
