@@ -3275,8 +3275,8 @@ fn a_lone_views_fall_a_few_heavy_windows_carry_clears_its_margin_by_the_ranks() 
     // less than a quarter of an encoder step per sample), its ranks past their margin.
     assert!(row.note.contains("their E_θ cannot see it"), "{}", row.note);
     assert!(
-        row.note
-            .contains("signed ranks clear their bar 2 times over"),
+        row.note.contains("signed ranks confirm the fall")
+            && row.note.contains("clearing their bar 2 times over"),
         "{}",
         row.note
     );

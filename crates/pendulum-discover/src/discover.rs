@@ -4783,20 +4783,32 @@ pub fn discover(
             ));
         }
         // (Only where it did not confirm it anyway: a view may clear its bar beyond its reach.)
-        if eq_ranked_by_margin
-            && !(eq_gain > fall_by_factor(eq_needed, SECOND_LOOK_GAIN_FACTOR))
-            && e_theta_cannot_see
-        {
+        // Which test confirmed the equation error's fall, where the ranks did what the spread
+        // could not: its bar once, or twice over for a view that judges alone.
+        let margin_by_ranks = e_theta_cannot_see
+            && eq_ranked_by_margin
+            && !(eq_gain > fall_by_factor(eq_needed, SECOND_LOOK_GAIN_FACTOR));
+        if (eq_ranked && !(eq_gain > eq_needed)) || margin_by_ranks {
             row.note.push_str(&format!(
-                "; its windows' signed ranks clear their bar {SECOND_LOOK_GAIN_FACTOR} times over (z = {eq_rank_z:.2} beyond {:.2})",
-                rank_z_by_factor(SECOND_LOOK_GAIN_FACTOR)
-            ));
-        }
-        if eq_ranked && !(eq_gain > eq_needed) {
-            row.note.push_str(&format!(
-                "; the validate runs' equation error falls {:.1} %, within the spread of its windows' differences ({:.1} %, which a few heavy windows carry), and its windows' signed ranks confirm the fall (z = {eq_rank_z:.2})",
+                "; the validate runs' equation error falls {:.1} %, within the spread of its windows' differences (bar {:.1} %{}, which a few heavy windows carry), and its windows' signed ranks confirm the fall (z = {eq_rank_z:.2}){}",
                 100.0 * eq_gain,
-                100.0 * eq_needed
+                100.0 * eq_needed,
+                if margin_by_ranks {
+                    format!(
+                        "; {SECOND_LOOK_GAIN_FACTOR} times over {:.1} %",
+                        100.0 * fall_by_factor(eq_needed, SECOND_LOOK_GAIN_FACTOR)
+                    )
+                } else {
+                    String::new()
+                },
+                if margin_by_ranks {
+                    format!(
+                        ", clearing their bar {SECOND_LOOK_GAIN_FACTOR} times over (beyond {:.2}) as a view judging alone must",
+                        rank_z_by_factor(SECOND_LOOK_GAIN_FACTOR)
+                    )
+                } else {
+                    String::new()
+                }
             ));
         }
         if !nonlinear && !eq_powered && !second_look && !eq_confirms {
