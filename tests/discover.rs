@@ -2362,13 +2362,8 @@ fn a_description_in_a_catalogue_entrys_shape_says_which() {
 /// `SURVEY_N` times (default 3) with drawn sizes and fresh seeds, then pairs; prints one line per
 /// campaign (named alone? estimate error; `unexplained`?) and the hit rate. For the issue 5 note.
 /// `SURVEY_SEED=s` draws other designs, sizes and damping (see [`survey_seed_offset`]).
-#[test]
-#[ignore = "survey for issue 12: 12 effects × SURVEY_N (default 3) drawn designs + 4 pairs; SURVEY_N=5 is ~30 minutes"]
-fn survey_issue_5_every_effect() {
-    let n: u64 = std::env::var("SURVEY_N")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(3);
+/// The every-effect survey's effects in its order (its draws' tags follow it).
+fn survey_effects() -> Vec<&'static str> {
     // The order the note's figures were drawn in (seeds follow it), then every catalogue effect
     // added since: the survey covers the whole catalogue.
     let mut effects = vec![
@@ -2393,6 +2388,35 @@ fn survey_issue_5_every_effect() {
         .filter(|e| !effects.contains(e))
         .collect();
     effects.extend(newer);
+    effects
+}
+
+/// The every-effect survey's campaign `effect` k at `SURVEY_DAMPING=drawn SURVEY_SEED=seed`,
+/// discovered in `dir`: its hidden size and discover's summary (the survey's own draw, so a
+/// test reproduces a survey line exactly).
+fn drawn_survey_case(dir: &Path, effect: &str, k: u64, seed: u64) -> (f64, DiscoverSummary) {
+    let e_idx = survey_effects()
+        .iter()
+        .position(|e| *e == effect)
+        .expect("a catalogue effect") as u64;
+    let tag = 100 * e_idx + k + 100_000 * seed;
+    let (truth, spec, base, a, b, mu) = draw_scaled(
+        effect,
+        &mut rng(1000 + tag),
+        1.0,
+        Some(&mut rng(9000 + tag)),
+    );
+    (truth, discover_in(dir, 5000 + tag, base, a, b, mu, &spec))
+}
+
+#[test]
+#[ignore = "survey for issue 12: 12 effects × SURVEY_N (default 3) drawn designs + 4 pairs; SURVEY_N=5 is ~30 minutes"]
+fn survey_issue_5_every_effect() {
+    let n: u64 = std::env::var("SURVEY_N")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(3);
+    let effects = survey_effects();
     let (mut hits, mut total, mut within) = (0, 0, 0);
     // Misses whose truth the validate runs cannot confirm either (see `truth_heldout_view`).
     let mut beyond = 0;
@@ -3225,15 +3249,8 @@ fn a_breakaway_the_held_out_equation_error_cannot_see_is_named_on_its_trajectori
 /// ranks (z = 5.6) confirm the fall; the row says which test did.
 #[test]
 fn a_fall_a_few_heavy_windows_carry_is_confirmed_by_the_windows_signed_ranks() {
-    let off = 1_700_000;
-    let (truth, spec, base, a, b, mu) = draw_scaled(
-        "viscous_quadratic",
-        &mut rng(1103 + off),
-        1.0,
-        Some(&mut rng(9103 + off)),
-    );
     let dir = tempfile::tempdir().unwrap();
-    let s = discover_in(dir.path(), 5103 + off, base, a, b, mu, &spec);
+    let (truth, s) = drawn_survey_case(dir.path(), "viscous_quadratic", 3, 17);
     assert_found(&s, "viscous_quadratic", truth, 0.10, 0.0);
     let row = s.discovery.row("viscous_quadratic").unwrap();
     // Within the spread's bar, beyond the ranks' one: the case this test is about.
@@ -3253,15 +3270,8 @@ fn a_fall_a_few_heavy_windows_carry_is_confirmed_by_the_windows_signed_ranks() {
 /// (z > 3.23, a chance of 1/40 squared).
 #[test]
 fn a_lone_views_fall_a_few_heavy_windows_carry_clears_its_margin_by_the_ranks() {
-    let off = 1_800_000;
-    let (truth, spec, base, a, b, mu) = draw_scaled(
-        "accel_delay",
-        &mut rng(1903 + off),
-        1.0,
-        Some(&mut rng(9903 + off)),
-    );
     let dir = tempfile::tempdir().unwrap();
-    let s = discover_in(dir.path(), 5903 + off, base, a, b, mu, &spec);
+    let (truth, s) = drawn_survey_case(dir.path(), "accel_delay", 3, 18);
     assert_eq!(s.discovery.accepted(), ["accel_delay"]);
     let row = s.discovery.row("accel_delay").unwrap();
     assert!(
