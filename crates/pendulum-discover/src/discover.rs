@@ -4769,7 +4769,12 @@ pub fn discover(
                 100.0 * cfg.gain_min.max(n)
             ));
         }
-        if e_theta_cannot_see && trajectories_measure && !eq_clears_margin {
+        // (Said whenever the spread's margin is not met, the ranks' pass beside it or not: the
+        // row gives every reason that holds.)
+        if e_theta_cannot_see
+            && trajectories_measure
+            && eq_gain <= fall_by_factor(eq_needed, SECOND_LOOK_GAIN_FACTOR)
+        {
             row.note.push_str(&format!(
                 "; {E_THETA_BLIND}, on its own bar, not {SECOND_LOOK_GAIN_FACTOR} times over ({:.1} %), because the identify runs' trajectories measure its size (they tell it from its absence, and their refit lies within the screen's interval or 10 %)",
                 100.0 * fall_by_factor(eq_needed, SECOND_LOOK_GAIN_FACTOR)
@@ -4782,28 +4787,27 @@ pub fn discover(
                 100.0 * fall_by_factor(eq_needed, SECOND_LOOK_GAIN_FACTOR)
             ));
         }
-        // (Only where it did not confirm it anyway: a view may clear its bar beyond its reach.)
         // Which test confirmed the equation error's fall, where the ranks did what the spread
         // could not: its bar once, or twice over for a view that judges alone.
         let margin_by_ranks = e_theta_cannot_see
             && eq_ranked_by_margin
             && !(eq_gain > fall_by_factor(eq_needed, SECOND_LOOK_GAIN_FACTOR));
         if (eq_ranked && !(eq_gain > eq_needed)) || margin_by_ranks {
+            let (asked, twice) = if margin_by_ranks {
+                (
+                    fall_by_factor(eq_needed, SECOND_LOOK_GAIN_FACTOR),
+                    format!(", its bar {SECOND_LOOK_GAIN_FACTOR} times over"),
+                )
+            } else {
+                (eq_needed, String::new())
+            };
             row.note.push_str(&format!(
-                "; the validate runs' equation error falls {:.1} %, within the spread of its windows' differences (bar {:.1} %{}, which a few heavy windows carry), and its windows' signed ranks confirm the fall (z = {eq_rank_z:.2}){}",
+                "; the validate runs' equation error falls {:.1} %, short of the {:.1} % the spread of its windows' differences asks{twice} (a few heavy windows carry that spread), and its windows' signed ranks confirm the fall (z = {eq_rank_z:.2}{})",
                 100.0 * eq_gain,
-                100.0 * eq_needed,
+                100.0 * asked,
                 if margin_by_ranks {
                     format!(
-                        "; {SECOND_LOOK_GAIN_FACTOR} times over {:.1} %",
-                        100.0 * fall_by_factor(eq_needed, SECOND_LOOK_GAIN_FACTOR)
-                    )
-                } else {
-                    String::new()
-                },
-                if margin_by_ranks {
-                    format!(
-                        ", clearing their bar {SECOND_LOOK_GAIN_FACTOR} times over (beyond {:.2}) as a view judging alone must",
+                        ", clearing their bar {SECOND_LOOK_GAIN_FACTOR} times over, beyond {:.2}, as a view judging alone must",
                         rank_z_by_factor(SECOND_LOOK_GAIN_FACTOR)
                     )
                 } else {
@@ -4811,6 +4815,7 @@ pub fn discover(
                 }
             ));
         }
+        // (Only where it did not confirm it anyway: a view may clear its bar beyond its reach.)
         if !nonlinear && !eq_powered && !second_look && !eq_confirms {
             row.note.push_str(&format!(
                 "; the validate runs' equation error cannot see it (were it true at the screen's size, it would fall {:.1} %, short of its bar): it neither confirms nor contradicts, and E_θ judges it",
