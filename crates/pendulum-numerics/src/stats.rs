@@ -74,11 +74,11 @@ pub fn bic(rss: f64, n: usize, k: usize) -> f64 {
 /// The Wilcoxon signed-rank statistic of paired differences `d` as a standard normal score:
 /// (W⁺ − n(n+1)/4) / σ, W⁺ the sum of the ranks of |d| over the positive differences, zeros
 /// left out, tied |d| given their mean rank and σ corrected for the ties (Lehmann,
-/// *Nonparametrics*, 1975, §3.2). Positive where the differences lean positive. Exact in
-/// distribution under the null of differences symmetric about 0 whatever their tails, which is
-/// why it is asked where a few heavy units carry most of a sum: there the spread of the
-/// differences (the paired t) cannot tell any fall from chance, since the sum's sign hangs on
-/// those few. NaN with fewer than one non-zero difference.
+/// *Nonparametrics*, 1975, §3.2). Positive where the differences lean positive. Its null
+/// distribution (differences symmetric about 0) holds whatever their tails, and the normal score
+/// approximates it closely beyond a dozen or so units; that is why it is asked where a few heavy
+/// units carry most of a sum: there the spread of the differences (the paired t) cannot tell any
+/// fall from chance, since the sum's sign hangs on those few. NaN without a non-zero difference.
 pub fn signed_rank_z(d: &[f64]) -> f64 {
     let mut a: Vec<(f64, bool)> = d
         .iter()
