@@ -3871,14 +3871,15 @@ pub fn discover(
         };
         // (Against its own noise, as every held-out gain here.)
         let screen_size_confirmed = at_screen.is_none_or(|(g, n)| g > cfg.gain_min.max(n));
-        let size_unasked = needs_e_theta && !(gain > gain_needed && screen_size_confirmed);
+        let size_rests_on_eq_alone =
+            needs_e_theta && !(gain > gain_needed && screen_size_confirmed);
         // Unless the view free to describe the torque otherwise takes this effect's own shape:
         // the generic sparse description of what the current model leaves (its library of
         // shapes in θ̇, θ, the forcing and time, judged on the validate rows like a catalogue
         // effect) is one term, the catalogue's twin of this effect
-        // (`crate::sparse::Description::catalogue_twin`), confirmed on the validate rows. The worry above is a departure the
-        // equation error only approximates with this column, and a freer description would take
-        // another shape or more terms for one. (Its size is the screen's own column fitted
+        // (`crate::sparse::Description::catalogue_twin`), confirmed on the validate rows. The
+        // worry above is a departure the equation error only approximates with this column, and
+        // a freer description would take another shape or more terms for one. (Its size is the screen's own column fitted
         // again, so it adds no second size: the equation error stays the view that measures it,
         // the trajectories not refusing it.) A hidden 7.10e-3 N·m constant dry torque
         // (`SURVEY_DAMPING=drawn SURVEY_SEED=20`, `coulomb_constant` k=2), screened at
@@ -3887,7 +3888,7 @@ pub fn discover(
         // error (36.6 % needed) while their E_θ, the base's μ having taken up most of the
         // torque, moved 0.4 % ± 13.4 % (the truth's own: 10.1 % ± 17 %); it was refused here
         // and reported `unexplained`, described as "+7.149e-3 N·m × sgn θ̇".
-        let described_as_itself = size_unasked
+        let described_as_itself = size_rests_on_eq_alone
             && ols(&view.id_rows, &current_cols)
                 .and_then(|f0| {
                     view.describe(
@@ -3901,7 +3902,7 @@ pub fn discover(
                     d.catalogue_twin() == Some(c.effect.as_str())
                         && d.heldout_gain > cfg.eq_gain_min.max(d.heldout_noise)
                 });
-        let size_unconfirmed = size_unasked && !described_as_itself;
+        let size_unconfirmed = size_rests_on_eq_alone && !described_as_itself;
         // A freer shape in the effect's own variable that does clearly better makes the
         // catalogue entry a partial explanation of a departure it does not describe.
         let partial = crate::sparse::family_beats_candidate(
