@@ -3575,9 +3575,12 @@ pub fn discover(
             heldout_gain(&before_judged, &val_judged)
         };
         let gain_needed = cfg.gain_min.max(noise);
-        let (eq_gain, eq_noise, reach, eq_rank_z) = match ols(&view.id_rows, &current_cols) {
+        // The current model's screen fit on the identify rows (also what the free description
+        // below starts from).
+        let current_ols = ols(&view.id_rows, &current_cols);
+        let (eq_gain, eq_noise, reach, eq_rank_z) = match &current_ols {
             Some(f0) => {
-                let before = view.sq_val(&f0);
+                let before = view.sq_val(f0);
                 let after = view.sq_val(&fit);
                 let (g, n) = paired_gain(&before, &after);
                 let d: Vec<f64> = before.iter().zip(&after).map(|(b, a)| b - a).collect();
@@ -3889,7 +3892,8 @@ pub fn discover(
         // torque, moved 0.4 % ± 13.4 % (the truth's own: 10.1 % ± 17 %); it was refused here
         // and reported `unexplained`, described as "+7.149e-3 N·m × sgn θ̇".
         let described_as_itself = size_rests_on_eq_alone
-            && ols(&view.id_rows, &current_cols)
+            && current_ols
+                .as_ref()
                 .and_then(|f0| {
                     view.describe(
                         &f0.residuals(&view.weak),
