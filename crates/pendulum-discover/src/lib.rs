@@ -3,6 +3,7 @@
 //! gain on runs the fit never saw.
 
 pub mod discover;
+pub mod envelope;
 pub mod screen;
 pub mod sparse;
 pub mod weak;
