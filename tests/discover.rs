@@ -2438,6 +2438,7 @@ fn survey_issue_5_every_effect() {
     let (mut hits, mut total, mut within) = (0, 0, 0);
     // Misses whose truth the validate runs cannot confirm either (see `truth_heldout_view`).
     let mut beyond = 0;
+    let mut unestimable = 0;
     // Named values whose interval holds the truth, of those named.
     let (mut holding, mut named_intervals) = (0, 0);
     // `SURVEY_SIZE_SCALE=0.4` draws every size at 0.4 times the catalogue's survey range.
@@ -2498,6 +2499,9 @@ fn survey_issue_5_every_effect() {
             let cfg = pendulum_discover::DiscoverConfig::default();
             let unconfirmable = truth_view.is_some_and(|(g, n)| g <= cfg.gain_min.max(n));
             beyond += usize::from(unconfirmable && !(hit && ok_est));
+            // A miss whose size the identify runs cannot estimate at all (no value: its column
+            // cannot be told from the model's on their windows, every identify run resting, say).
+            unestimable += usize::from(!(hit && ok_est) && !unconfirmable && !est.is_finite());
             // Does the named value's own 95 % interval hold the truth? (Counted, not asserted:
             // an interval may miss one draw in twenty.)
             let holds = row.is_some_and(|r| r.ci_low <= truth && truth <= r.ci_high);
@@ -2536,7 +2540,7 @@ fn survey_issue_5_every_effect() {
         }
     }
     eprintln!(
-        "survey-every: named alone in {hits} of {total}; of those within 10 % {within}; misses whose truth the validate runs cannot confirm either (E_θ): {beyond}; the named value's interval holds the truth in {holding} of {named_intervals}"
+        "survey-every: named alone in {hits} of {total}; of those within 10 % {within}; misses whose truth the validate runs cannot confirm either (E_θ): {beyond}; misses the identify runs cannot estimate: {unestimable}; the named value's interval holds the truth in {holding} of {named_intervals}"
     );
     // Pairs: both named, nothing else.
     let pairs = [
