@@ -2501,7 +2501,8 @@ fn survey_issue_5_every_effect() {
             beyond += usize::from(unconfirmable && !(hit && ok_est));
             // A miss whose size the identify runs cannot estimate at all (no value: its column
             // cannot be told from the model's on their windows, every identify run resting, say).
-            unestimable += usize::from(!(hit && ok_est) && !unconfirmable && !est.is_finite());
+            let missed = !(hit && ok_est);
+            unestimable += usize::from(missed && est.is_nan() && !unconfirmable);
             // Does the named value's own 95 % interval hold the truth? (Counted, not asserted:
             // an interval may miss one draw in twenty.)
             let holds = row.is_some_and(|r| r.ci_low <= truth && truth <= r.ci_high);

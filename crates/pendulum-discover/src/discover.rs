@@ -4137,11 +4137,11 @@ pub fn discover(
         // 8.48e-3, the free segments pooling to 8.84e-3 [8.64e-3, 9.04e-3]; the validate runs'
         // E_θ fell 42.6 % ± 21.7 % and their equation error 37.8 % (14.6 % needed), short of
         // twice the bar by 0.9 %, and it was not named.
-        let envelope_measures = second_look
+        let free_segments_measure = second_look
             && ci.0 <= 0.0
             && !refit_pinned
             && envelope_measures(&free_losses, &c.effect, refit_est);
-        let agree = agree || envelope_measures;
+        let agree = agree || free_segments_measure;
         let plausible = plausible_but_agree && agree;
         let accepted = if second_look {
             // Both held-out views: the validate runs' E_θ beyond twice the screen route's bar,
@@ -4182,7 +4182,7 @@ pub fn discover(
                 && !eq_powered
                 && eq_gain >= 0.0
                 && at_trajectories_shape.is_some_and(|(_, _, _, g, _)| g >= 0.0);
-            let margin = if envelope_measures {
+            let margin = if free_segments_measure {
                 1.0
             } else {
                 SECOND_LOOK_GAIN_FACTOR
@@ -4734,7 +4734,7 @@ pub fn discover(
                     "second look (the base model's fit was pinned at its search range; judged on the held-out runs and on whether the candidate's refit frees it)"
                 } else if second_look && after_pin.is_some() {
                     "second look (the model holding the first named effect was pinned at its search range; judged on the held-out runs and on whether the candidate's refit frees it)"
-                } else if second_look && envelope_measures {
+                } else if second_look && free_segments_measure {
                     "second look (the identify runs' equation error cannot see it; their free segments' pooled envelope holds the trajectories' value; judged on the held-out runs)"
                 } else if second_look {
                     "second look (the identify runs' equation error cannot see it; judged on the held-out runs)"

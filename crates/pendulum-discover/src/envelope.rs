@@ -10,6 +10,7 @@ use pendulum_process::Role;
 pub const ENVELOPE_MIN_S: f64 = 2.5;
 
 /// A run's free-decay segment (before its shaker starts) and its envelope.
+#[derive(Debug, Clone)]
 pub struct SegmentEnvelope {
     pub run: String,
     pub role: Role,
