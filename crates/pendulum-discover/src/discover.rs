@@ -2940,12 +2940,15 @@ fn anova(key: &[f64], res: &[f64], bins: usize) -> Option<(f64, f64)> {
 /// segments before their shakers start, as runs of the shaker model with the crank still
 /// ([`PreparedRun::unforced`]; others are ignored): every trajectory refit follows the identify
 /// runs' moving ones beside the forced windows, and the held-out E_θ the validate runs'
-/// ([`held_out_runs`]).
+/// ([`held_out_runs`]). `envelopes`: those segments read as free decays
+/// ([`crate::envelope::free_segment_envelopes`]); the identify runs' pooled losses are a view of
+/// a loss's size where the forced windows cannot see it.
 pub fn discover(
     ctx: &Context,
     base: Base,
     cfg: &DiscoverConfig,
     free_segments: &[PreparedRun],
+    envelopes: &[crate::envelope::SegmentEnvelope],
 ) -> Result<Discovery, ProcessError> {
     let free_moving = moving_free_segments(free_segments, Role::Identify);
     // The validate runs' own: the held-out E_θ judgement sees them ([`held_out_runs`]), and a
@@ -2982,9 +2985,10 @@ pub fn discover(
     // [`crate::envelope::pooled_envelope`]): a view of a loss's size beside the forced windows'
     // equation error and the trajectories ([`envelope_measures`]).
     let free_losses = {
-        let envs: Vec<_> = crate::envelope::free_segment_envelopes(ctx)
-            .into_iter()
+        let envs: Vec<_> = envelopes
+            .iter()
             .filter(|e| e.role == Role::Identify)
+            .cloned()
             .collect();
         crate::envelope::pooled_envelope(&crate::envelope::envelope_fits(&envs, ctx))
     };

@@ -285,7 +285,10 @@ fn run_unmarked(job: &DiscoverJob) -> Result<DiscoverSummary, JobError> {
             "the held-out E_θ also follows the free segment before the shaker starts of {n_val} validate run(s), and a named effect's value refitted on every run follows them too (one at rest adds nothing)"
         ));
     }
-    let d = discover(&ctx, job.base, &pipe.discover, &free)?;
+    // The free-decay segment before each shaker start: its envelope (the report's, and a view
+    // of a loss's size for discovery).
+    let envs = free_segment_envelopes(&ctx);
+    let d = discover(&ctx, job.base, &pipe.discover, &free, &envs)?;
     if let Some(note) = d
         .damping_check
         .as_ref()
@@ -511,8 +514,7 @@ fn run_unmarked(job: &DiscoverJob) -> Result<DiscoverSummary, JobError> {
     signature_plot(&sig_png, &d)?;
     summary.plots.push(sig_png.clone());
 
-    // The free-decay segment before each shaker start: its envelope's shape.
-    let envs = free_segment_envelopes(&ctx);
+    // The free-decay segments' envelopes (read before discovery).
     if !envs.is_empty() {
         write_envelopes(&out.join("envelopes.parquet"), &opts, &envs)?;
         summary.tables.push(out.join("envelopes.parquet"));
