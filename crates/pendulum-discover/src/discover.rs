@@ -2911,32 +2911,21 @@ const RESIDUAL_VARIABLES: [(&str, fn(&WeakRow) -> f64); 5] = [
     ("time", |r| r.tau_s),
 ];
 
-/// The finite pairs of `key` and `res` in `bins` equal-count bins of `key` (indices, by `key`),
-/// or `None` where there are fewer than ten a bin.
-fn equal_count_bins(key: &[f64], res: &[f64], bins: usize) -> Option<Vec<Vec<usize>>> {
+/// One-way ANOVA F statistic of `res` grouped into `bins` equal-count bins of `key`, and an
+/// approximate p-value (Wilson–Hilferty normal approximation of the F tail).
+fn anova(key: &[f64], res: &[f64], bins: usize) -> Option<(f64, f64)> {
     let mut idx: Vec<usize> = (0..key.len())
         .filter(|&i| key[i].is_finite() && res[i].is_finite())
         .collect();
-    if bins == 0 || idx.len() < bins * 10 {
+    if idx.len() < bins * 10 {
         return None;
     }
     idx.sort_by(|&a, &b| key[a].total_cmp(&key[b]));
     let n = idx.len();
-    Some(
-        (0..bins)
-            .map(|b| idx[b * n / bins..(b + 1) * n / bins].to_vec())
-            .collect(),
-    )
-}
-
-/// One-way ANOVA F statistic of `res` grouped into `bins` equal-count bins of `key`, and an
-/// approximate p-value (Wilson–Hilferty normal approximation of the F tail).
-fn anova(key: &[f64], res: &[f64], bins: usize) -> Option<(f64, f64)> {
-    let groups = equal_count_bins(key, res, bins)?;
-    let n: usize = groups.iter().map(Vec::len).sum();
-    let mean = groups.iter().flatten().map(|&i| res[i]).sum::<f64>() / n as f64;
+    let mean = idx.iter().map(|&i| res[i]).sum::<f64>() / n as f64;
     let (mut ssb, mut ssw) = (0.0, 0.0);
-    for g in &groups {
+    for b in 0..bins {
+        let g = &idx[b * n / bins..(b + 1) * n / bins];
         let m = g.iter().map(|&i| res[i]).sum::<f64>() / g.len() as f64;
         ssb += g.len() as f64 * (m - mean).powi(2);
         ssw += g.iter().map(|&i| (res[i] - m).powi(2)).sum::<f64>();
@@ -2944,31 +2933,6 @@ fn anova(key: &[f64], res: &[f64], bins: usize) -> Option<(f64, f64)> {
     let (d1, d2) = ((bins - 1) as f64, (n - bins) as f64);
     let f = (ssb / d1) / (ssw / d2).max(1e-300);
     Some((f, pendulum_numerics::f_sf(f, d1, d2)))
-}
-
-/// The step function [`anova`] tests: `res`'s mean in each of `bins` equal-count bins of `key`,
-/// as (the bin's lowest key, its mean). Evaluated by [`step_at`].
-fn bin_means(key: &[f64], res: &[f64], bins: usize) -> Option<Vec<(f64, f64)>> {
-    let groups = equal_count_bins(key, res, bins)?;
-    Some(
-        groups
-            .iter()
-            .map(|g| {
-                let m = g.iter().map(|&i| res[i]).sum::<f64>() / g.len() as f64;
-                (key[g[0]], m)
-            })
-            .collect(),
-    )
-}
-
-/// The step function `steps` ([`bin_means`]) at `k`: the mean of the last bin starting at or
-/// below `k` (the first bin's below its start; 0 where `k` is not finite).
-fn step_at(steps: &[(f64, f64)], k: f64) -> f64 {
-    if !k.is_finite() || steps.is_empty() {
-        return 0.0;
-    }
-    let i = steps.partition_point(|&(lo, _)| lo <= k);
-    steps[i.saturating_sub(1)].1
 }
 
 /// Runs discovery on a context whose pipeline has aligned the runs, estimated initial states and
@@ -5410,64 +5374,13 @@ pub fn discover(
             .map(|((r, e), _)| (f(r), *e))
             .unzip()
     };
-    // Each variable the identify rows' remaining error varies with is judged on the validate
-    // rows, as the generic description below is: the identify rows' binned means (the step
-    // function the ANOVA tests), taken off the validate rows' error at the size that fits them,
-    // must take more off its sum of squares than the equation error's bar ([`paired_gain`]).
-    // The variable reported is the one of largest F among those so judged. Unjudged, a nothing-hidden
-    // drawn design (`SURVEY_DAMPING=drawn SURVEY_SEED=30`, campaign 17: one chaotic identify
-    // run, every other run resting) was reported `unexplained`, "the remaining equation error
-    // varies with dθ/dt (F = 7.6, p = 2.4e-10 over 12 bins)", with nothing there to explain.
-    let val_res = final_ols.residuals(&view.val_rows);
-    let val_refs: Vec<&WeakRow> = view.val_rows.iter().collect();
-    let val_before = crate::weak::sq_with_run_offsets(&val_refs, val_res.clone());
-    let mut worst: Option<(String, f64, f64, f64)> = None;
+    let mut worst: Option<(String, f64, f64)> = None;
     for (name, f) in &RESIDUAL_VARIABLES[..3] {
         let (k, e) = pick(f);
-        let Some((fstat, p)) = anova(&k, &e, 12) else {
-            continue;
-        };
-        if p >= 1e-6 || worst.as_ref().is_some_and(|w| fstat <= w.1) {
-            continue;
-        }
-        let Some(steps) = bin_means(&k, &e, 12) else {
-            continue;
-        };
-        // The step's shape at the validate rows, its size refitted there (weighted least
-        // squares, one number): a departure's torque scales with each run's bob and swing, so
-        // the identify rows' size need not be the validate rows'. An off-centre code disc
-        // (`DEPARTURE_SEED=4`, `encoder_eccentricity` k=0) left an error varying with θ (mod
-        // 2π) at F = 42.8 whose step, at the identify rows' size, took −72 % off the validate
-        // rows' error, and at 0.24 of it +10.7 % (noise 5.9 %). The same sign only: a step
-        // that fits the validate rows upside down is not the structure the identify rows hold.
-        let at: Vec<f64> = view
-            .val_rows
-            .iter()
-            .map(|r| step_at(&steps, f(r)))
-            .collect();
-        let (sxy, sxx) = view
-            .val_rows
-            .iter()
-            .zip(&val_res)
-            .zip(&at)
-            .fold((0.0, 0.0), |(sxy, sxx), ((r, e), s)| {
-                (sxy + r.weight * e * s, sxx + r.weight * s * s)
-            });
-        let scale = if sxx > 0.0 { sxy / sxx } else { 0.0 };
-        if scale <= 0.0 {
-            continue;
-        }
-        let after: Vec<f64> = val_res
-            .iter()
-            .zip(&at)
-            .map(|(e, s)| e - scale * s)
-            .collect();
-        let (gain, noise) = paired_gain(
-            &val_before,
-            &crate::weak::sq_with_run_offsets(&val_refs, after),
-        );
-        if gain > cfg.eq_gain_min.max(noise) {
-            worst = Some((name.to_string(), fstat, p, gain));
+        if let Some((fstat, p)) = anova(&k, &e, 12) {
+            if p < 1e-6 && worst.as_ref().is_none_or(|w| fstat > w.1) {
+                worst = Some((name.to_string(), fstat, p));
+            }
         }
     }
     // A generic sparse description of what remains, judged on the validate rows like a
@@ -5515,11 +5428,8 @@ pub fn discover(
             "{} (the validate runs do not confirm this shape)",
             d.words(&|r| view.weak_runs[r].0.clone())
         )),
-        _ => worst.map(|(name, f, p, gain)| {
-            format!(
-                "the remaining equation error varies with {name} (F = {f:.1}, p = {p:.1e} over 12 bins; the identify rows' means per bin take {:.1} % off the validate rows' error at the size that fits them)",
-                100.0 * gain
-            )
+        _ => worst.map(|(name, f, p)| {
+            format!("the remaining equation error varies with {name} (F = {f:.1}, p = {p:.1e} over 12 bins)")
         }),
     };
     // Whether the runs disagree on the model's own terms (the variable "the run").
@@ -5706,51 +5616,6 @@ pub fn discover(
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// The step function the ANOVA tests is each equal-count bin's mean, read at any key by the
-    /// bin it falls in (below the first bin's start, the first bin's): a residual that is a
-    /// step in its key is taken off exactly, on the rows it was measured on and on others.
-    #[test]
-    fn the_binned_means_are_the_step_they_measure_and_read_it_at_any_key() {
-        let step = |k: f64| {
-            if k < 0.0 {
-                -1.0
-            } else if k < 1.0 {
-                0.5
-            } else {
-                2.0
-            }
-        };
-        let key: Vec<f64> = (0..300)
-            .map(|i| -1.5 + 4.0 * f64::from(i) / 300.0)
-            .collect();
-        let res: Vec<f64> = key.iter().map(|&k| step(k)).collect();
-        let steps = bin_means(&key, &res, 3).expect("100 rows a bin");
-        assert_eq!(steps.len(), 3);
-        // (Its edges fall inside the bins here, so the means mix: each is its rows' own mean.)
-        for (b, &(lo, m)) in steps.iter().enumerate() {
-            let rows: Vec<f64> = res[100 * b..100 * (b + 1)].to_vec();
-            assert_eq!(lo, key[100 * b]);
-            assert!((m - rows.iter().sum::<f64>() / 100.0).abs() < 1e-12);
-            assert_eq!(step_at(&steps, lo), m);
-            assert_eq!(step_at(&steps, lo + 1e-9), m);
-        }
-        assert_eq!(step_at(&steps, -100.0), steps[0].1);
-        assert_eq!(step_at(&steps, 100.0), steps[2].1);
-        assert_eq!(step_at(&steps, f64::NAN), 0.0);
-        // Bins at the step's own edges take it off exactly, at keys of other rows too.
-        let key: Vec<f64> = (0..300)
-            .map(|i| f64::from(i % 3) + 0.001 * f64::from(i))
-            .collect();
-        let res: Vec<f64> = key.iter().map(|&k| step(k - 0.5)).collect();
-        let steps = bin_means(&key, &res, 3).expect("100 rows a bin");
-        for k in [0.1, 0.25, 1.1, 1.25, 2.1, 2.9] {
-            assert!((step_at(&steps, k) - step(k - 0.5)).abs() < 1e-12, "at {k}");
-        }
-        // Too few rows a bin: no step, as no ANOVA.
-        assert!(bin_means(&key[..29], &res[..29], 3).is_none());
-        assert!(anova(&key[..29], &res[..29], 3).is_none());
-    }
 
     /// The free segments measure a loss's size only where they name that loss and hold the
     /// trajectories' value: inside their interval or 10 % of their estimate, never at or below 0.
