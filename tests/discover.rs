@@ -1346,6 +1346,32 @@ fn nothing_hidden_from_the_reference_base_on_a_mostly_resting_design_names_nothi
     );
 }
 
+/// The every-effect survey's `encoder_offset` k=4 at `SURVEY_DAMPING=drawn SURVEY_SEED=23`: a
+/// 4.78e-2 rad offset on a design of mixed bobs, the base fit pinned (a 1.0, b 1.0, μ 0.25). A
+/// k = 1 position torque screened ahead of it (ΔBIC −553 against −510) was named at 8.7e-2 N·m,
+/// the offset never judged. The torque would hold each bob at rest by an angle scaling as
+/// 1/(m g l), 0.027–0.070 rad over these bobs, while the eight free decays swing about
+/// 0.043–0.057 rad, one angle: the torque stands in for the offset, which is named.
+#[test]
+#[ignore = "slow set (a survey draw: `encoder_offset` k=4 at SURVEY_DAMPING=drawn SURVEY_SEED=23, 25 s): the default suite checks the rule on the pendulum-discover unit tests free_decays_hanging_at_one_angle_over_mixed_bobs_read_as_an_offset and a_position_torques_rest_angle_balances_gravity; README, Tests"]
+fn a_position_torque_whose_rest_angles_the_free_decays_do_not_follow_is_not_named_for_an_offset() {
+    let truth = 0.047817603676635886;
+    let s = discover(
+        2_305_804,
+        Base::Reference,
+        0.04969228490274835,
+        0.6449612146705063,
+        0.1639897345676306,
+        &format!("encoder_offset_rad = {truth}"),
+    );
+    assert_found(&s, "encoder_offset", truth, 0.0, 2e-3);
+    let row = s
+        .discovery
+        .row("position_torque")
+        .expect("a position_torque row");
+    assert!(row.note.contains("stands in for an offset"), "{}", row.note);
+}
+
 /// Bearing friction past the study's search range (μ < 0.25), nothing hidden, on a drawn design
 /// (the false-alarm survey's campaign 3 at `SURVEY_SEED=32`, its drawn μ 0.174 raised to 0.36).
 /// The base fit (300 generations) stopped at μ 0.2495, a hair short of the end, with a 0.647

@@ -865,6 +865,47 @@ fn per_run_mean(values: &[f64], nominal: f64) -> (f64, f64, f64) {
     (mean, half, delta_bic)
 }
 
+/// Where a position torque T_p sin(kθ + φ) holds a bob of `mgl` (m g l, N·m) at rest: the
+/// equilibrium nearest hanging, sin θ + (T_p/m g l) sin(kθ + φ) = 0, by Newton from 0.
+fn position_torque_rest_rad(mgl: f64, t_p: f64, k: f64, phi: f64) -> f64 {
+    let p = t_p / mgl;
+    let mut th = 0.0f64;
+    for _ in 0..20 {
+        let f = th.sin() + p * (k * th + phi).sin();
+        let df = th.cos() + p * k * (k * th + phi).cos();
+        if !(df.abs() > 1e-12) {
+            break;
+        }
+        let step = f / df;
+        th -= step;
+        if step.abs() < 1e-12 {
+            break;
+        }
+    }
+    th
+}
+
+/// Whether the identify runs' free decays (`readings`: each run's m g l and the angle its free
+/// decay swings about) hang where an offset of the reading puts them, one angle for every bob,
+/// rather than where a position torque (T_p, k, φ) would: the torque's rest angles
+/// ([`position_torque_rest_rad`]) against the readings' common mean, by the runs' scatter about
+/// each, ΔBIC n ln(RSS_torque / RSS_mean) beyond 10 (Kass and Raftery's "very strong"). Each
+/// reading also holds its run's zeroing error and how well a centre is read, which the mean's
+/// scatter carries. Not with fewer than three readings.
+fn hangs_as_an_offset(readings: &[(f64, f64)], t_p: f64, k: f64, phi: f64) -> bool {
+    if readings.len() < 3 || !(t_p.is_finite() && phi.is_finite()) {
+        return false;
+    }
+    let n = readings.len() as f64;
+    let mean = readings.iter().map(|r| r.1).sum::<f64>() / n;
+    let rss_mean = readings.iter().map(|r| (r.1 - mean).powi(2)).sum::<f64>();
+    let rss_torque = readings
+        .iter()
+        .map(|&(mgl, h)| (h - position_torque_rest_rad(mgl, t_p, k, phi)).powi(2))
+        .sum::<f64>();
+    n * (rss_torque.max(1e-300) / rss_mean.max(1e-300)).ln() > 10.0
+}
+
 /// The identify runs' direct reading of an offset of the angle's reading: each run's free decay
 /// swings about the offset plus that run's own zeroing error (a few counts, rig.md), so the 95 %
 /// interval of their mean from the runs' scatter ([`per_run_mean`]). `None` with fewer than
@@ -3060,6 +3101,17 @@ pub fn discover(
         .filter(|r| r.role == Role::Identify)
         .filter_map(|r| ctx.hanging.get(&r.id).copied().flatten())
         .collect();
+    // The same readings with each run's m g l (N·m), for a torque's rest angles.
+    let hanging_by_bob: Vec<(f64, f64)> = ctx
+        .runs
+        .iter()
+        .filter(|r| r.role == Role::Identify)
+        .filter_map(|r| {
+            let h = ctx.hanging.get(&r.id).copied().flatten()?;
+            let mgl = r.rig.m_kg * r.rig.g_m_s2 * r.rig.l_m;
+            (mgl > 0.0).then_some((mgl, h))
+        })
+        .collect();
     let mut val_runs = ctx.prepared(Role::Validate, &cfg.validate.window, "discover")?;
     if !ctx.runs.iter().any(|r| r.role == Role::Identify) {
         return Err(ProcessError::BadConfig {
@@ -4408,7 +4460,33 @@ pub fn discover(
         let accel_disagrees =
             accel_tilt.is_some_and(|(d, h, _)| sizes_disagree(est, 1.96 * se, d, h));
         let accel_refuses = accepted && !size_disagrees && !stand_in && accel_disagrees;
-        let accepted = accepted && !size_disagrees && !stand_in && !accel_disagrees;
+        // A k = 1 position torque holds each bob at rest off the vertical by an angle that
+        // scales as 1/(m g l); an offset of the reading, by one angle for every bob. Where the identify runs' free decays swing about one angle that the torque's
+        // per-bob rest angles do not follow ([`hangs_as_an_offset`]), the torque stands in for
+        // an offset. A hidden 4.78e-2 rad offset on a drawn design of mixed bobs
+        // (`SURVEY_DAMPING=drawn SURVEY_SEED=23`, `encoder_offset` k=4; the base fit pinned at
+        // a 1.0, b 1.0, μ 0.25) was screened behind a k = 1 position torque (ΔBIC −553 against
+        // −510), which was named at 8.7e-2 N·m; its rest angles ran 0.027–0.070 rad by bob
+        // while the eight free decays swung about 0.043–0.057.
+        let hangs_offset = accepted
+            && !size_disagrees
+            && !stand_in
+            && !accel_disagrees
+            // k = 1 only: a torque T_p sin(θ + φ) tilts gravity, so a swing of any size is
+            // centred on its rest angle; a cogging torque's lobes average out over a swing.
+            && c.effect == "position_torque"
+            && c.k == 1
+            && match (
+                spec.index_of("position_torque.T_p"),
+                spec.index_of("position_torque.phi_p"),
+            ) {
+                (Some(i), Some(j)) => {
+                    hangs_as_an_offset(&hanging_by_bob, refit_x[i], f64::from(c.k), refit_x[j])
+                }
+                _ => false,
+            };
+        let accepted =
+            accepted && !size_disagrees && !stand_in && !accel_disagrees && !hangs_offset;
         // The pair look's second candidate, judged beside the first one held provisionally:
         // the first must not do better refitted away in the model holding both (its E_θ gain
         // beside the second, and the gain's noise).
@@ -4856,6 +4934,8 @@ pub fn discover(
                     "; a freer shape of the same torque, or one no freer in its variable, explains the departure better: a partial explanation, not named"
                 } else if size_disagrees {
                     "; the validate runs' own rows put its size elsewhere (one size does not describe the departure on the runs the fit never saw): a partial explanation, not named"
+                } else if hangs_offset {
+                    "; the identify runs' free decays swing about one angle whatever the bob, where this torque would hold each bob at rest by an angle scaling as 1/(m g l): it stands in for an offset of the reading, not named"
                 } else if stand_in {
                     "; beside the first round's other candidates, the identify and the validate rows each put its size at under a tenth of this, their intervals excluding it: it stands in for them, not named"
                 } else if accel_refuses {
@@ -5719,6 +5799,47 @@ pub fn discover(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A k = 1 position torque's rest angle has a closed form, tan θ = −p sin φ / (1 + p cos φ)
+    /// (p = T_p / m g l); Newton's agrees, and for k = 3 it solves the balance it states.
+    #[test]
+    fn a_position_torques_rest_angle_balances_gravity() {
+        for (mgl, t_p, phi) in [(1.46, 0.0868, -1.59), (3.19, 0.04, -1.0), (1.25, 0.02, 2.5)] {
+            let p: f64 = t_p / mgl;
+            let closed = (-p * f64::sin(phi)).atan2(1.0 + p * f64::cos(phi));
+            let th = position_torque_rest_rad(mgl, t_p, 1.0, phi);
+            assert!((th - closed).abs() < 1e-12, "{th} against {closed}");
+        }
+        let th = position_torque_rest_rad(1.46, 0.05, 3.0, 0.7);
+        assert!((th.sin() + 0.05 / 1.46 * (3.0 * th + 0.7).sin()).abs() < 1e-12);
+        assert!(th.abs() > 1e-3);
+    }
+
+    /// Free decays that swing about one angle on bobs of different m g l are an offset's, not
+    /// a position torque's (whose rest angle scales as 1/(m g l)); centres that follow the
+    /// torque's rest angles are the torque's; one bob, or fewer than three readings, cannot tell.
+    #[test]
+    fn free_decays_hanging_at_one_angle_over_mixed_bobs_read_as_an_offset() {
+        let (t_p, phi) = (0.0868, -1.59);
+        let mgls = [1.46, 1.28, 1.28, 1.68, 3.19, 1.25, 1.48, 2.52];
+        // Each run's zeroing error, a count or two of a 4096-count encoder.
+        let zero = [1.5e-3, -1.5e-3, 0.0, 3.0e-3, -3.0e-3, 1.5e-3, 0.0, -1.5e-3];
+        let offset: Vec<(f64, f64)> = mgls
+            .iter()
+            .zip(&zero)
+            .map(|(&m, z)| (m, 0.048 + z))
+            .collect();
+        assert!(hangs_as_an_offset(&offset, t_p, 1.0, phi));
+        let torque: Vec<(f64, f64)> = mgls
+            .iter()
+            .zip(&zero)
+            .map(|(&m, z)| (m, position_torque_rest_rad(m, t_p, 1.0, phi) + z))
+            .collect();
+        assert!(!hangs_as_an_offset(&torque, t_p, 1.0, phi));
+        let one_bob: Vec<(f64, f64)> = zero.iter().map(|z| (1.46, 0.0595 + z)).collect();
+        assert!(!hangs_as_an_offset(&one_bob, t_p, 1.0, phi));
+        assert!(!hangs_as_an_offset(&offset[..2], t_p, 1.0, phi));
+    }
 
     /// The free segments measure a loss's size only where they name that loss and hold the
     /// trajectories' value: inside their interval or 10 % of their estimate, never at or below 0.
