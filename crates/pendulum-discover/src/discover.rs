@@ -4460,33 +4460,7 @@ pub fn discover(
         let accel_disagrees =
             accel_tilt.is_some_and(|(d, h, _)| sizes_disagree(est, 1.96 * se, d, h));
         let accel_refuses = accepted && !size_disagrees && !stand_in && accel_disagrees;
-        // A k = 1 position torque holds each bob at rest off the vertical by an angle that
-        // scales as 1/(m g l); an offset of the reading, by one angle for every bob. Where the identify runs' free decays swing about one angle that the torque's
-        // per-bob rest angles do not follow ([`hangs_as_an_offset`]), the torque stands in for
-        // an offset. A hidden 4.78e-2 rad offset on a drawn design of mixed bobs
-        // (`SURVEY_DAMPING=drawn SURVEY_SEED=23`, `encoder_offset` k=4; the base fit pinned at
-        // a 1.0, b 1.0, μ 0.25) was screened behind a k = 1 position torque (ΔBIC −553 against
-        // −510), which was named at 8.7e-2 N·m; its rest angles ran 0.027–0.070 rad by bob
-        // while the eight free decays swung about 0.043–0.057.
-        let hangs_offset = accepted
-            && !size_disagrees
-            && !stand_in
-            && !accel_disagrees
-            // k = 1 only: a torque T_p sin(θ + φ) tilts gravity, so a swing of any size is
-            // centred on its rest angle; a cogging torque's lobes average out over a swing.
-            && c.effect == "position_torque"
-            && c.k == 1
-            && match (
-                spec.index_of("position_torque.T_p"),
-                spec.index_of("position_torque.phi_p"),
-            ) {
-                (Some(i), Some(j)) => {
-                    hangs_as_an_offset(&hanging_by_bob, refit_x[i], f64::from(c.k), refit_x[j])
-                }
-                _ => false,
-            };
-        let accepted =
-            accepted && !size_disagrees && !stand_in && !accel_disagrees && !hangs_offset;
+        let accepted = accepted && !size_disagrees && !stand_in && !accel_disagrees;
         // The pair look's second candidate, judged beside the first one held provisionally:
         // the first must not do better refitted away in the model holding both (its E_θ gain
         // beside the second, and the gain's noise).
@@ -4598,6 +4572,30 @@ pub fn discover(
                 .iter()
                 .any(|b| b.candidate.effect != c.effect && b.delta_bic < cfg.screen_threshold);
         let accepted = accepted && !held_back;
+        // A k = 1 position torque holds each bob at rest off the vertical by an angle that
+        // scales as 1/(m g l); an offset of the reading, by one angle for every bob. Where the
+        // identify runs' free decays swing about one angle that the torque's per-bob rest angles
+        // do not follow ([`hangs_as_an_offset`]), the torque stands in for an offset. A hidden
+        // 4.78e-2 rad offset on a drawn design of mixed bobs (`SURVEY_DAMPING=drawn
+        // SURVEY_SEED=23`, `encoder_offset` k=4; the base fit pinned at a 1.0, b 1.0, μ 0.25)
+        // was screened behind a k = 1 position torque (ΔBIC −553 against −510), which was named
+        // at 8.7e-2 N·m; its rest angles ran 0.027–0.070 rad by bob while the eight free decays
+        // swung about 0.043–0.057. Asked after `held_back`, a deferral: a torque held back is
+        // asked when it is judged again. Only k = 1: T_p sin(θ + φ) tilts gravity, so a swing of
+        // any size is centred on its rest angle; a cogging torque's lobes average out over one.
+        let hangs_offset = accepted
+            && c.effect == "position_torque"
+            && c.k == 1
+            && match (
+                spec.index_of("position_torque.T_p"),
+                spec.index_of("position_torque.phi_p"),
+            ) {
+                (Some(i), Some(j)) => {
+                    hangs_as_an_offset(&hanging_by_bob, refit_x[i], f64::from(c.k), refit_x[j])
+                }
+                _ => false,
+            };
+        let accepted = accepted && !hangs_offset;
         // A generalisation (a breakaway, which becomes a constant dry torque as v_s grows past
         // the swings' speeds) no better on the validate runs' E_θ than the effect it generalises,
         // judged and refused before it: it stands for that effect at the limit of its shape, and
