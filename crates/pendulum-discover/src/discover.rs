@@ -557,8 +557,8 @@ fn practically_significant(
 
 /// The base fit again where the identify runs' free segments put one of its damping terms past
 /// the end of its search range: that end widened to hold the free segments' value, and the
-/// damping refitted from it (Nelder–Mead, initial states held), kept when it follows the
-/// identify runs better. The base fit's ranges are otherwise the catalogue's (a term pinned at
+/// damping refitted from it (Nelder–Mead, initial states held) on the forced windows and the
+/// free swings together, kept when it follows both better than the base fit's damping does. The base fit's ranges are otherwise the catalogue's (a term pinned at
 /// one is the first sign of a departure the base lacks, and discover reports it, see
 /// `FitConfig::widen_ranges`), but the study's μ < 0.25, b < 1 N·s/m are its search's, not
 /// physics: on a nothing-hidden drawn design with μ = 0.317 the base fit (300 generations) went
@@ -5815,7 +5815,8 @@ mod tests {
 
     /// Free decays that swing about one angle on bobs of different m g l are an offset's, not
     /// a position torque's (whose rest angle scales as 1/(m g l)); centres that follow the
-    /// torque's rest angles are the torque's; one bob, or fewer than three readings, cannot tell.
+    /// torque's rest angles are the torque's, on mixed bobs or on one; fewer than three readings
+    /// cannot tell.
     #[test]
     fn free_decays_hanging_at_one_angle_over_mixed_bobs_read_as_an_offset() {
         let (t_p, phi) = (0.0868, -1.59);
