@@ -1372,6 +1372,36 @@ fn a_position_torque_whose_rest_angles_the_free_decays_do_not_follow_is_not_name
     assert!(row.note.contains("stands in for an offset"), "{}", row.note);
 }
 
+/// Nothing hidden on a drawn design of mixed bobs (the false-alarm survey's campaign 48 at
+/// `SURVEY_DAMPING=drawn SURVEY_SEED=33`). The screen offered a k = 1 position torque of
+/// 1.6e-4 N·m, which tilts the lightest bob's rest (m g l = 1.73 N·m) by 0.06 of an encoder
+/// count, and it was named on two marginal passes (E_θ falling 2.1 % ± 1.9 % against a 2.0 %
+/// bar, the equation error 6.0 % against 5.0 %), its interval pooled over every run holding 0.
+/// A torque of the angle that tilts no bob's rest by a count is within the rig's tolerance
+/// (each run's count is zeroed by hand to a few counts): nothing is named.
+#[test]
+#[ignore = "slow set (a survey draw: the false-alarm survey's campaign 48 at SURVEY_DAMPING=drawn SURVEY_SEED=33, 10 s): the default suite checks the tolerance against the surveys' sizes in pendulum-model's every_surveyed_size_lies_beyond_the_rigs_tolerance; README, Tests"]
+fn a_torque_that_tilts_no_rest_by_an_encoder_count_is_not_named() {
+    let s = discover(
+        3_300_348,
+        Base::Reference,
+        0.026187504903749728,
+        0.300279988750168,
+        0.1293693424511089,
+        "",
+    );
+    assert!(
+        s.discovery.accepted().is_empty(),
+        "named {:?}",
+        s.discovery.accepted()
+    );
+    let row = s
+        .discovery
+        .row("position_torque")
+        .expect("a position_torque row");
+    assert!(row.note.contains("tilts no bob's rest"), "{}", row.note);
+}
+
 /// Bearing friction past the study's search range (μ < 0.25), nothing hidden, on a drawn design
 /// (the false-alarm survey's campaign 3 at `SURVEY_SEED=32`, its drawn μ 0.174 raised to 0.36).
 /// The base fit (300 generations) stopped at μ 0.2495, a hair short of the end, with a 0.647

@@ -543,16 +543,29 @@ fn to_si(c: &Candidate, fit: &crate::screen::Ols) -> (f64, f64, &'static str) {
 
 /// Effects whose size is within the rig's normal tolerances are not named (the catalogue's
 /// [`pendulum_model::Tolerance`]: the encoder's hand zeroing, the stamps' timing jitter
-/// measured on the campaign, the inertia the point-mass bob leaves out).
-fn practically_significant(
-    effect: &str,
-    estimate: f64,
-    stamp_jitter_s: f64,
-    bob_inertia_kg_m2: f64,
-) -> bool {
+/// measured on the campaign, the inertia the point-mass bob leaves out, a torque of the angle
+/// that tilts no bob's rest by a count).
+fn practically_significant(effect: &str, estimate: f64, scale: &RigScale) -> bool {
     pendulum_model::effects::by_name(effect)
         .and_then(|e| e.tolerance())
-        .is_none_or(|t| !(estimate.abs() <= t.bound(stamp_jitter_s, bob_inertia_kg_m2)))
+        .is_none_or(|t| {
+            !(estimate.abs()
+                <= t.bound(
+                    scale.stamp_jitter_s,
+                    scale.bob_inertia_kg_m2,
+                    scale.gravity_torque_n_m,
+                ))
+        })
+}
+
+/// The campaign's measures that [`pendulum_model::Tolerance`] bounds scale with.
+struct RigScale {
+    /// One accelerometer stamp's timing error, s ([`stamp_jitter_s`]).
+    stamp_jitter_s: f64,
+    /// The smallest m l² over the runs, kg·m² ([`lightest_bob_inertia_kg_m2`]).
+    bob_inertia_kg_m2: f64,
+    /// The smallest m g l over the runs, N·m ([`lightest_gravity_torque_n_m`]).
+    gravity_torque_n_m: f64,
 }
 
 /// The base fit again where the identify runs' free segments put one of its damping terms past
@@ -654,6 +667,15 @@ fn pins(spec: &ModelSpec, params: &[f64]) -> Vec<(FitParam, pendulum_process::fi
             side => Some((p, side)),
         })
         .collect()
+}
+
+/// The smallest m g l over the campaign's runs with a known bob, N·m (NaN if none).
+fn lightest_gravity_torque_n_m(ctx: &Context) -> f64 {
+    ctx.runs
+        .iter()
+        .map(|r| r.rig.m_kg * r.rig.g_m_s2 * r.rig.l_m)
+        .filter(|v| v.is_finite() && *v > 0.0)
+        .fold(f64::NAN, f64::min)
 }
 
 /// The smallest m l² over the campaign's runs with a known bob, kg·m² (NaN if none).
@@ -2149,7 +2171,7 @@ fn with_run_zeros(
 ) -> Vec<PreparedRun> {
     let bound = pendulum_model::effects::by_name("encoder_offset")
         .and_then(|e| e.tolerance())
-        .map_or(0.0, |t| t.bound(0.0, 0.0));
+        .map_or(0.0, |t| t.bound(0.0, 0.0, 0.0));
     if bound <= 0.0 || ics.len() != 2 * runs.len() {
         return runs.to_vec();
     }
@@ -3139,8 +3161,11 @@ pub fn discover(
         &free_moving,
         cfg.refit_evals,
     );
-    let jitter_s = stamp_jitter_s(ctx);
-    let bob_inertia = lightest_bob_inertia_kg_m2(ctx);
+    let scale = RigScale {
+        stamp_jitter_s: stamp_jitter_s(ctx),
+        bob_inertia_kg_m2: lightest_bob_inertia_kg_m2(ctx),
+        gravity_torque_n_m: lightest_gravity_torque_n_m(ctx),
+    };
     // A drifting crank speed, read from the accelerometer first: when it is significant the
     // equation-error view uses the re-aligned forcing, so that its growing phase error is not
     // mistaken for another effect (an accelerometer lag, say).
@@ -4138,11 +4163,11 @@ pub fn discover(
         // 2.24e-4 kg·m² by the identify runs' screen (1.04 % of the lightest bob's m l², its
         // tolerance 1 %) and to 1.31e-4 by their trajectories (0.6 %); it was named on the
         // validate runs' equation error while their E_θ fell 8.0 % ± 10.2 %.
-        let significant = practically_significant(&c.effect, est, jitter_s, bob_inertia)
+        let significant = practically_significant(&c.effect, est, &scale)
             && !(torque_or_inertia
                 && size_power == Some(true)
                 && refit_est.is_finite()
-                && !practically_significant(&c.effect, refit_est, jitter_s, bob_inertia));
+                && !practically_significant(&c.effect, refit_est, &scale));
         // An offset of the angle's reading beside a torque that follows the unwrapped angle: with
         // the offset's columns in, what remains is still described by the unwrapped θ (a spring,
         // a wrong scale of the angle), confirmed on the validate rows. No offset makes such a
@@ -4758,7 +4783,7 @@ pub fn discover(
         if screen_route
             && !possible
             && !heldout_rejects
-            && practically_significant(&c.effect, est, jitter_s, bob_inertia)
+            && practically_significant(&c.effect, est, &scale)
         {
             refused = Some(format!(
                 "the best catalogue candidate, {} (ΔBIC {:.1}), fits the departure only with a \
@@ -4945,7 +4970,7 @@ pub fn discover(
                 } else if runs_disagree {
                     "; with it in, the runs still disagree on the size of the model's damping (each run's own factor takes more than twice the bar off the other blocks' equation error): a partial explanation of a departure that follows the run, not named"
                 } else if !significant {
-                    "; within the rig's own tolerance (encoder zeroing, the stamps' timing jitter, or the inertia the point-mass bob leaves out): not named"
+                    "; within the rig's own tolerance (encoder zeroing, the stamps' timing jitter, the inertia the point-mass bob leaves out, or a torque of the angle that tilts no bob's rest by an encoder count): not named"
                 } else if refit_pinned {
                     "; the trajectory refit stops at its search range's bound, its size's or its shape's (the bound, not the data, set it): not accepted"
                 } else if !agree {

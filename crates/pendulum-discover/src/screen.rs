@@ -519,7 +519,7 @@ pub fn is_nuisance(s: &Screened) -> bool {
     s.candidate.add == [col]
         && s.fit
             .coef_of(col)
-            .is_some_and(|(v, _)| v.abs() <= tol.bound(f64::NAN, f64::NAN))
+            .is_some_and(|(v, _)| v.abs() <= tol.bound(f64::NAN, f64::NAN, f64::NAN))
 }
 
 /// How much lower a generalisation's ΔBIC must be than that of the effect it generalises

@@ -257,15 +257,23 @@ pub enum Tolerance {
     /// |size| ≤ this fraction of the lightest run's m l² (kg·m²): what the point-mass model
     /// itself leaves out (the bob's own moment about its centre, the rod's and the shaft's).
     BobInertia(f64),
+    /// |size| ≤ the torque that tilts the lightest-hung run's rest (the smallest m g l over the
+    /// campaign's runs, N·m) by this many encoder counts: a torque of the angle that moves no
+    /// bob's hanging position by a count is one the encoder cannot place apart from each run's
+    /// own hand zeroing, which is good to a few counts.
+    RestTilt(f64),
 }
 
 impl Tolerance {
-    /// The bound, given the campaign's stamp jitter (s) and lightest bob inertia (kg·m²).
-    pub fn bound(self, stamp_jitter_s: f64, bob_inertia_kg_m2: f64) -> f64 {
+    /// The bound, given the campaign's stamp jitter (s), lightest bob inertia (kg·m²) and
+    /// smallest gravity torque m g l (N·m).
+    pub fn bound(self, stamp_jitter_s: f64, bob_inertia_kg_m2: f64, gravity_torque_n_m: f64) -> f64 {
+        let count_rad = 2.0 * std::f64::consts::PI / 4096.0;
         match self {
-            Tolerance::EncoderCounts(n) => n * 2.0 * std::f64::consts::PI / 4096.0,
+            Tolerance::EncoderCounts(n) => n * count_rad,
             Tolerance::StampJitter(k) => k * stamp_jitter_s,
             Tolerance::BobInertia(f) => f * bob_inertia_kg_m2,
+            Tolerance::RestTilt(n) => n * count_rad * gravity_torque_n_m,
         }
     }
 }
