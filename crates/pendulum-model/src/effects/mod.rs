@@ -267,7 +267,12 @@ pub enum Tolerance {
 impl Tolerance {
     /// The bound, given the campaign's stamp jitter (s), lightest bob inertia (kg·m²) and
     /// smallest gravity torque m g l (N·m).
-    pub fn bound(self, stamp_jitter_s: f64, bob_inertia_kg_m2: f64, gravity_torque_n_m: f64) -> f64 {
+    pub fn bound(
+        self,
+        stamp_jitter_s: f64,
+        bob_inertia_kg_m2: f64,
+        gravity_torque_n_m: f64,
+    ) -> f64 {
         let count_rad = 2.0 * std::f64::consts::PI / 4096.0;
         match self {
             Tolerance::EncoderCounts(n) => n * count_rad,
