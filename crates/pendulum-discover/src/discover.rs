@@ -24,8 +24,9 @@
 //! `extra_inertia`: θ_off²/2 · sin θ) or left as `unexplained`.
 //!
 //! After the accepted effects are in, the remaining equation error is binned against θ̇, θ and the
-//! forcing phase; a one-way analysis of variance with p < 1e-6 on any of them is reported as
-//! `unexplained`, with where it lives.
+//! forcing phase; a one-way analysis of variance with p < 1e-6 on any of them, whose bin means
+//! the validate runs' rows confirm as they confirm an effect, is reported as `unexplained`, with
+//! where it lives.
 
 use pendulum_fit::{Cost, Problem};
 use pendulum_model::effects::Kind;
@@ -3086,6 +3087,99 @@ fn anova(key: &[f64], res: &[f64], bins: usize) -> Option<(f64, f64)> {
     Some((f, pendulum_numerics::f_sf(f, d1, d2)))
 }
 
+/// The bin means of `res` over `key` in [`anova`]'s equal-count bins, each weighted by the rows'
+/// `weight` (the inverse variance the held-out squares are weighted by: an unweighted mean is
+/// carried by the noisiest, fastest rows), as (each bin's largest key, its mean); `None` with
+/// fewer than ten rows a bin.
+fn bin_means(key: &[f64], res: &[f64], weight: &[f64], bins: usize) -> Option<Vec<(f64, f64)>> {
+    let mut idx: Vec<usize> = (0..key.len())
+        .filter(|&i| key[i].is_finite() && res[i].is_finite())
+        .collect();
+    if bins == 0 || idx.len() < bins * 10 {
+        return None;
+    }
+    idx.sort_by(|&a, &b| key[a].total_cmp(&key[b]));
+    let n = idx.len();
+    Some(
+        (0..bins)
+            .map(|b| {
+                let g = &idx[b * n / bins..(b + 1) * n / bins];
+                let (swe, sw) = g.iter().fold((0.0, 0.0), |(a, b), &i| {
+                    (a + weight[i] * res[i], b + weight[i])
+                });
+                (key[g[g.len() - 1]], if sw > 0.0 { swe / sw } else { 0.0 })
+            })
+            .collect(),
+    )
+}
+
+/// A one-way structure of the remaining equation error over a variable (`key` of every row of
+/// `rows`), judged on rows the bin means were not taken from, as a catalogue effect is judged on
+/// held-out runs: the validate rows against the identify rows' bin means, and each identify run
+/// against the other identify runs' (so that a campaign whose validate runs rest still has
+/// held-out rows). Each held-out row's residual less the mean of the bin its own key falls in
+/// (the outer bins open); the fall of their weighted squared equation error, each run's zeroing
+/// error refitted, with its noise ([`paired_gain`]). `None` without held-out rows.
+fn bin_means_heldout(
+    rows: &[WeakRow],
+    key: &[f64],
+    res: &[f64],
+    is_identify: &[bool],
+    is_validate: &[bool],
+    bins: usize,
+) -> Option<(f64, f64)> {
+    let mut id_runs: Vec<usize> = (0..rows.len())
+        .filter(|&i| is_identify[i])
+        .map(|i| rows[i].run)
+        .collect();
+    id_runs.sort_unstable();
+    id_runs.dedup();
+    // (rows the means come from, rows they are judged on)
+    let folds = std::iter::once((
+        (0..rows.len())
+            .filter(|&i| is_identify[i])
+            .collect::<Vec<usize>>(),
+        (0..rows.len())
+            .filter(|&i| is_validate[i])
+            .collect::<Vec<usize>>(),
+    ))
+    .chain(id_runs.iter().map(|&run| {
+        let (held, from): (Vec<usize>, Vec<usize>) = (0..rows.len())
+            .filter(|&i| is_identify[i])
+            .partition(|&i| rows[i].run == run);
+        (from, held)
+    }));
+    let finite = |v: f64| if v.is_finite() { v } else { 0.0 };
+    let (mut before, mut after) = (Vec::new(), Vec::new());
+    for (from, held) in folds {
+        if held.len() < 3 {
+            continue;
+        }
+        let k: Vec<f64> = from.iter().map(|&i| key[i]).collect();
+        let e: Vec<f64> = from.iter().map(|&i| res[i]).collect();
+        let w: Vec<f64> = from.iter().map(|&i| rows[i].weight).collect();
+        let Some(means) = bin_means(&k, &e, &w, bins) else {
+            continue;
+        };
+        let predict = |k: f64| -> f64 {
+            if !k.is_finite() {
+                return 0.0;
+            }
+            let b = means.iter().position(|&(u, _)| k <= u);
+            means[b.unwrap_or(means.len() - 1)].1
+        };
+        let held_rows: Vec<&WeakRow> = held.iter().map(|&i| &rows[i]).collect();
+        let e0: Vec<f64> = held.iter().map(|&i| finite(res[i])).collect();
+        let e1: Vec<f64> = held
+            .iter()
+            .map(|&i| finite(res[i]) - predict(key[i]))
+            .collect();
+        before.extend(crate::weak::sq_with_run_offsets(&held_rows, e0));
+        after.extend(crate::weak::sq_with_run_offsets(&held_rows, e1));
+    }
+    (!before.is_empty()).then(|| paired_gain(&before, &after))
+}
+
 /// Runs discovery on a context whose pipeline has aligned the runs, estimated initial states and
 /// steady states, and fitted the base model (`ctx.fits[0]`). `free_segments`: the runs' free
 /// segments before their shakers start, as runs of the shaker model with the crank still
@@ -5580,12 +5674,27 @@ pub fn discover(
             .map(|((r, e), _)| (f(r), *e))
             .unzip()
     };
-    let mut worst: Option<(String, f64, f64)> = None;
+    // The validate runs' rows judge it, as they judge a catalogue effect and the generic
+    // description below: on identify rows alone, thousands of windows whose noise grows with
+    // |θ̇| make a one-way F beyond p < 1e-6 out of a fit that is right. Nothing hidden on drawn
+    // designs whose validate runs rest or tumble, the base's damping within 5 % of the truth,
+    // gave "varies with dθ/dt" at F = 6.0 (`SURVEY_DAMPING=drawn SURVEY_SEED=33`, campaign 40;
+    // seed 30's campaign 17 and seed 32's campaign 28 alike).
+    let val_mask: Vec<bool> = view
+        .weak
+        .iter()
+        .map(|r| view.weak_runs[r.run].1 == Role::Validate)
+        .collect();
+    let mut worst: Option<(String, f64, f64, (f64, f64))> = None;
     for (name, f) in &RESIDUAL_VARIABLES[..3] {
         let (k, e) = pick(f);
         if let Some((fstat, p)) = anova(&k, &e, 12) {
             if p < 1e-6 && worst.as_ref().is_none_or(|w| fstat > w.1) {
-                worst = Some((name.to_string(), fstat, p));
+                let key: Vec<f64> = view.weak.iter().map(f).collect();
+                let held = bin_means_heldout(&view.weak, &key, &final_res, &id_mask, &val_mask, 12);
+                if let Some(held) = held.filter(|&(g, n)| g > cfg.eq_gain_min.max(n)) {
+                    worst = Some((name.to_string(), fstat, p, held));
+                }
             }
         }
     }
@@ -5634,8 +5743,12 @@ pub fn discover(
             "{} (the validate runs do not confirm this shape)",
             d.words(&|r| view.weak_runs[r].0.clone())
         )),
-        _ => worst.map(|(name, f, p)| {
-            format!("the remaining equation error varies with {name} (F = {f:.1}, p = {p:.1e} over 12 bins)")
+        _ => worst.map(|(name, f, p, (g, n))| {
+            format!(
+                "the remaining equation error varies with {name} (F = {f:.1}, p = {p:.1e} over 12 bins of the identify runs' rows; on rows they were not taken from, the validate runs' and each identify run's beside the others', their bin means take {:.1} % ± {:.1} % off the equation error)",
+                100.0 * g,
+                100.0 * n
+            )
         }),
     };
     // Whether the runs disagree on the model's own terms (the variable "the run").
@@ -5822,6 +5935,80 @@ pub fn discover(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Rows of `runs` runs (the first `identify` of them identify runs), 400 windows each over
+    /// θ̇ in (−5, 5) rad/s, and their residuals: `structure(run, θ̇)` plus zero-mean noise whose
+    /// spread grows with |θ̇| (as the equation error's does: the stamps jitter).
+    fn one_way_rows(
+        runs: usize,
+        identify: usize,
+        structure: impl Fn(usize, f64) -> f64,
+    ) -> (Vec<WeakRow>, Vec<f64>, Vec<bool>, Vec<bool>) {
+        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
+        let mut uniform = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let (mut rows, mut res) = (Vec::new(), Vec::new());
+        for run in 0..runs {
+            for i in 0..400 {
+                let w = -5.0 + 10.0 * (i as f64 + uniform()) / 400.0;
+                // Box–Muller
+                let z = (-2.0 * uniform().max(1e-300).ln()).sqrt()
+                    * (2.0 * std::f64::consts::PI * uniform()).cos();
+                rows.push(WeakRow {
+                    run,
+                    tau_s: i as f64 * 0.2,
+                    theta: 0.0,
+                    theta_dot_rad_s: w,
+                    phase: f64::NAN,
+                    a_y_meas: 0.0,
+                    a_x_meas: 0.0,
+                    target: 0.0,
+                    x: Vec::new(),
+                    weight: 1.0,
+                    bob_inertia_kg_m2: 1.0,
+                    lib: Vec::new(),
+                    speeds: Default::default(),
+                });
+                res.push(structure(run, w) + 0.1 * (1.0 + w.abs()) * z);
+            }
+        }
+        let is_id = rows.iter().map(|r| r.run < identify).collect();
+        let is_val = rows.iter().map(|r| r.run >= identify).collect();
+        (rows, res, is_id, is_val)
+    }
+
+    /// A remaining equation error that follows a variable on every run is confirmed on rows its
+    /// bin means were not taken from, whether the validate runs have rows or not; one that only
+    /// one identify run carries, which a one-way F on the identify rows still finds, is not.
+    #[test]
+    fn a_one_way_structure_is_confirmed_only_on_rows_it_was_not_taken_from() {
+        let key =
+            |rows: &[WeakRow]| -> Vec<f64> { rows.iter().map(|r| r.theta_dot_rad_s).collect() };
+        let confirmed = |g: f64, n: f64| g > 0.05_f64.max(n);
+        let every = |_: usize, w: f64| 0.2 * w.signum();
+        let (rows, res, id, val) = one_way_rows(6, 4, every);
+        let (g, n) = bin_means_heldout(&rows, &key(&rows), &res, &id, &val, 12).unwrap();
+        assert!(confirmed(g, n), "{g} ± {n}");
+        // The validate runs rest (no rows): the identify runs judge one another.
+        let (rows, res, id, val) = one_way_rows(4, 4, every);
+        let (g, n) = bin_means_heldout(&rows, &key(&rows), &res, &id, &val, 12).unwrap();
+        assert!(confirmed(g, n), "{g} ± {n}");
+        let one_run = |run: usize, w: f64| if run == 0 { 0.6 * (w * 1.3).sin() } else { 0.0 };
+        let (rows, res, id, val) = one_way_rows(6, 4, one_run);
+        let k = key(&rows);
+        let (ki, ei): (Vec<f64>, Vec<f64>) = (0..rows.len())
+            .filter(|&i| id[i])
+            .map(|i| (k[i], res[i]))
+            .unzip();
+        let (_, p) = anova(&ki, &ei, 12).unwrap();
+        assert!(p < 1e-6, "the identify rows' F finds it (p = {p:e})");
+        let (g, n) = bin_means_heldout(&rows, &k, &res, &id, &val, 12).unwrap();
+        assert!(!confirmed(g, n), "{g} ± {n}");
+    }
 
     /// A k = 1 position torque's rest angle has a closed form, tan θ = −p sin φ / (1 + p cos φ)
     /// (p = T_p / m g l); Newton's agrees, and for k = 3 it solves the balance it states.

@@ -1220,7 +1220,7 @@ fn write_report(
             let _ = writeln!(r, "**Unexplained:** {u}.\n");
         }
         None => {
-            let _ = writeln!(r, "No structure is left in the equation error against dθ/dt, θ or the forcing phase (p ≥ 1e-6).\n");
+            let _ = writeln!(r, "No structure is left in the equation error against dθ/dt, θ or the forcing phase that rows the fit did not see confirm (a one-way F on the identify runs' rows with p < 1e-6, whose bin means take more than max(5 %, its noise) off the equation error of the validate runs' rows and of each identify run's from the others' means), and the generic description finds none the validate runs confirm.\n");
         }
     }
     if let Some(ext) = &d.extended {
