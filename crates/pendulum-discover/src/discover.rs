@@ -563,9 +563,9 @@ fn practically_significant(effect: &str, estimate: f64, scale: &RigScale) -> boo
 struct RigScale {
     /// One accelerometer stamp's timing error, s ([`stamp_jitter_s`]).
     stamp_jitter_s: f64,
-    /// The smallest m l² over the runs, kg·m² ([`lightest_bob_inertia_kg_m2`]).
+    /// The smallest m l² over the runs, kg·m².
     bob_inertia_kg_m2: f64,
-    /// The smallest m g l over the runs, N·m ([`lightest_gravity_torque_n_m`]).
+    /// The smallest m g l over the runs, N·m.
     gravity_torque_n_m: f64,
 }
 
@@ -670,20 +670,11 @@ fn pins(spec: &ModelSpec, params: &[f64]) -> Vec<(FitParam, pendulum_process::fi
         .collect()
 }
 
-/// The smallest m g l over the campaign's runs with a known bob, N·m (NaN if none).
-fn lightest_gravity_torque_n_m(ctx: &Context) -> f64 {
+/// The smallest of `of(rig)` over the campaign's runs with a known bob (NaN if none).
+fn smallest_over_runs(ctx: &Context, of: impl Fn(&pendulum_process::RigParams) -> f64) -> f64 {
     ctx.runs
         .iter()
-        .map(|r| r.rig.m_kg * r.rig.g_m_s2 * r.rig.l_m)
-        .filter(|v| v.is_finite() && *v > 0.0)
-        .fold(f64::NAN, f64::min)
-}
-
-/// The smallest m l² over the campaign's runs with a known bob, kg·m² (NaN if none).
-fn lightest_bob_inertia_kg_m2(ctx: &Context) -> f64 {
-    ctx.runs
-        .iter()
-        .map(|r| r.rig.m_kg * r.rig.l_m * r.rig.l_m)
+        .map(|r| of(&r.rig))
         .filter(|v| v.is_finite() && *v > 0.0)
         .fold(f64::NAN, f64::min)
 }
@@ -3063,21 +3054,32 @@ const RESIDUAL_VARIABLES: [(&str, fn(&WeakRow) -> f64); 5] = [
     ("time", |r| r.tau_s),
 ];
 
-/// One-way ANOVA F statistic of `res` grouped into `bins` equal-count bins of `key`, and an
-/// approximate p-value (Wilson–Hilferty normal approximation of the F tail).
-fn anova(key: &[f64], res: &[f64], bins: usize) -> Option<(f64, f64)> {
+/// The rows with a finite `key` and `res`, sorted by `key` and cut into `bins` equal-count bins;
+/// `None` with fewer than ten rows a bin.
+fn equal_count_bins(key: &[f64], res: &[f64], bins: usize) -> Option<Vec<Vec<usize>>> {
     let mut idx: Vec<usize> = (0..key.len())
         .filter(|&i| key[i].is_finite() && res[i].is_finite())
         .collect();
-    if idx.len() < bins * 10 {
+    if bins == 0 || idx.len() < bins * 10 {
         return None;
     }
     idx.sort_by(|&a, &b| key[a].total_cmp(&key[b]));
     let n = idx.len();
-    let mean = idx.iter().map(|&i| res[i]).sum::<f64>() / n as f64;
+    Some(
+        (0..bins)
+            .map(|b| idx[b * n / bins..(b + 1) * n / bins].to_vec())
+            .collect(),
+    )
+}
+
+/// One-way ANOVA F statistic of `res` grouped into `bins` equal-count bins of `key`, and an
+/// approximate p-value (Wilson–Hilferty normal approximation of the F tail).
+fn anova(key: &[f64], res: &[f64], bins: usize) -> Option<(f64, f64)> {
+    let groups = equal_count_bins(key, res, bins)?;
+    let n: usize = groups.iter().map(Vec::len).sum();
+    let mean = groups.iter().flatten().map(|&i| res[i]).sum::<f64>() / n as f64;
     let (mut ssb, mut ssw) = (0.0, 0.0);
-    for b in 0..bins {
-        let g = &idx[b * n / bins..(b + 1) * n / bins];
+    for g in &groups {
         let m = g.iter().map(|&i| res[i]).sum::<f64>() / g.len() as f64;
         ssb += g.len() as f64 * (m - mean).powi(2);
         ssw += g.iter().map(|&i| (res[i] - m).powi(2)).sum::<f64>();
@@ -3092,18 +3094,11 @@ fn anova(key: &[f64], res: &[f64], bins: usize) -> Option<(f64, f64)> {
 /// carried by the noisiest, fastest rows), as (each bin's largest key, its mean); `None` with
 /// fewer than ten rows a bin.
 fn bin_means(key: &[f64], res: &[f64], weight: &[f64], bins: usize) -> Option<Vec<(f64, f64)>> {
-    let mut idx: Vec<usize> = (0..key.len())
-        .filter(|&i| key[i].is_finite() && res[i].is_finite())
-        .collect();
-    if bins == 0 || idx.len() < bins * 10 {
-        return None;
-    }
-    idx.sort_by(|&a, &b| key[a].total_cmp(&key[b]));
-    let n = idx.len();
+    let groups = equal_count_bins(key, res, bins)?;
     Some(
-        (0..bins)
-            .map(|b| {
-                let g = &idx[b * n / bins..(b + 1) * n / bins];
+        groups
+            .iter()
+            .map(|g| {
                 let (swe, sw) = g.iter().fold((0.0, 0.0), |(a, b), &i| {
                     (a + weight[i] * res[i], b + weight[i])
                 });
@@ -3257,8 +3252,8 @@ pub fn discover(
     );
     let scale = RigScale {
         stamp_jitter_s: stamp_jitter_s(ctx),
-        bob_inertia_kg_m2: lightest_bob_inertia_kg_m2(ctx),
-        gravity_torque_n_m: lightest_gravity_torque_n_m(ctx),
+        bob_inertia_kg_m2: smallest_over_runs(ctx, |r| r.m_kg * r.l_m * r.l_m),
+        gravity_torque_n_m: smallest_over_runs(ctx, |r| r.m_kg * r.g_m_s2 * r.l_m),
     };
     // A drifting crank speed, read from the accelerometer first: when it is significant the
     // equation-error view uses the re-aligned forcing, so that its growing phase error is not
