@@ -1402,6 +1402,41 @@ fn a_torque_that_tilts_no_rest_by_an_encoder_count_is_not_named() {
     assert!(row.note.contains("tilts no bob's rest"), "{}", row.note);
 }
 
+/// Nothing hidden on a drawn design whose identify runs all rest under their shaking (the
+/// false-alarm survey's campaign 7 at `SURVEY_DAMPING=drawn SURVEY_SEED=33`): the base fit put
+/// μ at 0.2499 for a rig of 0.189, and `unexplained` said its fit was cut short by its search
+/// range, that the model did not follow the runs. The free swings reject that damping, and one
+/// inside the range follows them and the forced windows both (the damping check's "not pinned",
+/// which says so on its own): the bound says only that the forced windows left the split among
+/// the terms open. Nothing named, nothing `unexplained`, the damping check "not pinned" with its
+/// joint μ within 10 % of the rig's.
+#[test]
+#[ignore = "slow set (a survey draw: the false-alarm survey's campaign 7 at SURVEY_DAMPING=drawn SURVEY_SEED=33, 20 s): the default suite checks the damping check's verdict on a_damping_split_the_shaken_runs_leave_open_is_pinned_by_the_free_swings, whose base is not at a bound; the bound's words are checked here only; README, Tests"]
+fn a_pin_the_free_swings_undo_is_not_called_a_departure() {
+    let mu = 0.1887450232008837;
+    let s = discover(
+        3_300_307,
+        Base::Reference,
+        0.014170907668057599,
+        0.5138873641057464,
+        mu,
+        "",
+    );
+    let d = &s.discovery;
+    assert!(d.accepted().is_empty(), "named {:?}", d.accepted());
+    assert!(d.unexplained.is_none(), "{:?}", d.unexplained);
+    let check = d.damping_check.as_ref().expect("a damping check");
+    assert_eq!(
+        check.verdict(),
+        pendulum_discover::DampingVerdict::NotPinned
+    );
+    let joint_mu = check.joint_params[d.base.spec.index_of("mu").unwrap()];
+    assert!(
+        (joint_mu - mu).abs() < 0.10 * mu,
+        "joint μ {joint_mu} against {mu}"
+    );
+}
+
 /// Bearing friction past the study's search range (μ < 0.25), nothing hidden, on a drawn design
 /// (the false-alarm survey's campaign 3 at `SURVEY_SEED=32`, its drawn μ 0.174 raised to 0.36).
 /// The base fit (300 generations) stopped at μ 0.2495, a hair short of the end, with a 0.647
