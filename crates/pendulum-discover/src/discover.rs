@@ -25,8 +25,8 @@
 //!
 //! After the accepted effects are in, the remaining equation error is binned against θ̇, θ and the
 //! forcing phase; a one-way analysis of variance with p < 1e-6 on any of them, whose bin means
-//! the validate runs' rows confirm as they confirm an effect, is reported as `unexplained`, with
-//! where it lives.
+//! rows they were not taken from confirm as held-out runs confirm an effect, is reported as
+//! `unexplained`, with where it lives.
 
 use pendulum_fit::{Cost, Problem};
 use pendulum_model::effects::Kind;
@@ -5669,8 +5669,8 @@ pub fn discover(
             .map(|((r, e), _)| (f(r), *e))
             .unzip()
     };
-    // The validate runs' rows judge it, as they judge a catalogue effect and the generic
-    // description below: on identify rows alone, thousands of windows whose noise grows with
+    // Rows the bin means were not taken from judge it ([`bin_means_heldout`]), as the validate
+    // runs judge a catalogue effect and the generic description below: on identify rows alone, thousands of windows whose noise grows with
     // |θ̇| make a one-way F beyond p < 1e-6 out of a fit that is right. Nothing hidden on drawn
     // designs whose validate runs rest or tumble, the base's damping within 5 % of the truth,
     // gave "varies with dθ/dt" at F = 6.0 (`SURVEY_DAMPING=drawn SURVEY_SEED=33`, campaign 40;
@@ -5942,6 +5942,17 @@ pub fn discover(
 mod tests {
     use super::*;
 
+    /// Uniform on [0, 1) from a xorshift generator: deterministic, no extra dependency.
+    fn xorshift_uniform() -> impl FnMut() -> f64 {
+        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
+        move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        }
+    }
+
     /// Rows of `runs` runs (the first `identify` of them identify runs), 400 windows each over
     /// θ̇ in (−5, 5) rad/s, and their residuals: `structure(run, θ̇)` plus zero-mean noise whose
     /// spread grows with |θ̇| (as the equation error's does: the stamps jitter).
@@ -5950,13 +5961,7 @@ mod tests {
         identify: usize,
         structure: impl Fn(usize, f64) -> f64,
     ) -> (Vec<WeakRow>, Vec<f64>, Vec<bool>, Vec<bool>) {
-        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
-        let mut uniform = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut uniform = xorshift_uniform();
         let (mut rows, mut res) = (Vec::new(), Vec::new());
         for run in 0..runs {
             for i in 0..400 {
@@ -6349,14 +6354,9 @@ mod tests {
     fn a_torque_in_a_few_windows_reaches_less_than_its_noise() {
         let ncol = crate::weak::columns().len();
         let (dry, drag) = (0, 2);
-        // Uniform on [−1, 1) from a xorshift generator (deterministic, no extra dependency).
-        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
-        let mut uniform = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 52) as f64 - 1.0
-        };
+        // Uniform on [−1, 1).
+        let mut unit = xorshift_uniform();
+        let mut uniform = move || 2.0 * unit() - 1.0;
         let mut rows_with = |few: bool| -> Vec<WeakRow> {
             (0..400)
                 .map(|i| {
