@@ -2024,6 +2024,7 @@ fn an_offset_beside_an_inertia_is_not_refused_by_a_view_its_runs_zeros_blind() {
 /// runs' zeroing errors (−1, 0, 2, −1, −2 counts against −1, 2, 2), which the screen's intervals
 /// leave out; the comparison now allows for them, read from where the free decays hang.
 #[test]
+#[ignore = "slow set (a survey pair, 60 s; moved out of the default suite on the fifty-eighth session, whose default suite took 15:06 alone): the default suite checks the rule on the pendulum-discover unit test two_sets_of_runs_read_an_offset_apart_by_their_zeros_mean and the pair's other draw on an_offset_beside_an_inertia_is_not_refused_by_a_view_its_runs_zeros_blind; README, Tests"]
 fn an_offset_whose_two_sets_of_runs_differ_by_their_zeros_is_named() {
     offset_and_inertia_pair_is_named(400_000);
 }
