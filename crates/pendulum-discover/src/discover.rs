@@ -3123,12 +3123,7 @@ fn bin_means_heldout(
     is_validate: &[bool],
     bins: usize,
 ) -> Option<(f64, f64)> {
-    let mut id_runs: Vec<usize> = (0..rows.len())
-        .filter(|&i| is_identify[i])
-        .map(|i| rows[i].run)
-        .collect();
-    id_runs.sort_unstable();
-    id_runs.dedup();
+    let id_runs = crate::weak::runs_of(rows, is_identify);
     // (rows the means come from, rows they are judged on)
     let folds = std::iter::once((
         (0..rows.len())

@@ -700,12 +700,7 @@ pub fn run_spread(
             .sum()
     };
     let fitting = |r: &WeakRow| (r.tau_s / RUN_BLOCK_S).floor().rem_euclid(2.0) == 0.0;
-    let mut runs: Vec<usize> = (0..rows.len())
-        .filter(|&i| is_identify[i])
-        .map(|i| rows[i].run)
-        .collect();
-    runs.sort_unstable();
-    runs.dedup();
+    let runs = crate::weak::runs_of(rows, is_identify);
     let mut test: Vec<usize> = Vec::new();
     let mut after: Vec<f64> = Vec::new();
     let mut factors: Vec<(usize, f64)> = Vec::new();

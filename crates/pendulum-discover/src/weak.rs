@@ -218,6 +218,17 @@ fn one() -> f64 {
     1.0
 }
 
+/// The distinct runs (ascending) of the rows `mask` keeps.
+pub(crate) fn runs_of(rows: &[WeakRow], mask: &[bool]) -> Vec<usize> {
+    let mut runs: Vec<usize> = (0..rows.len())
+        .filter(|&i| mask[i])
+        .map(|i| rows[i].run)
+        .collect();
+    runs.sort_unstable();
+    runs.dedup();
+    runs
+}
+
 /// Weighted squared residuals `res` of `rows` with each run's own encoder zeroing error refitted
 /// (least squares on the observation column within the run). On held-out rows that error is a
 /// nuisance of the run, not a prediction of any model (as a validate run's initial state is for
