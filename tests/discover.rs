@@ -927,32 +927,43 @@ fn a_breakaway_the_screen_puts_at_the_wrong_speed_is_refitted_at_the_one_the_tra
 }
 
 /// A rig with quadratic drag (a = 0.08 kg/m) and bearing friction (μ = 0.15) analysed with the
-/// study's linear base (b alone), on two drawn designs (those of `SURVEY_DAMPING=drawn`'s
-/// `stribeck` k=1 at seeds 16 and 15). Alone, each missing term is a partial explanation of
-/// their sum: on the first the drag was refused because the runs' own damping factors still
-/// disagreed with it in, on the second the bearing friction was judged first and refused so, and
-/// the drag then as a freer shape's part; nothing was named on either. Both are named as a pair,
-/// each at its value beside the other.
+/// study's linear base (b alone), on a drawn design (that of `SURVEY_DAMPING=drawn`'s `stribeck`
+/// k=1 at seed 16). Alone, each missing term is a partial explanation of their sum: the drag was
+/// refused because the runs' own damping factors still disagreed with it in, and nothing was
+/// named. Both are named as a pair, each at its value beside the other.
 #[test]
 fn a_base_missing_two_terms_names_both_where_each_alone_is_a_partial_explanation() {
-    for seed in [1_606_201, 1_506_201] {
-        let s = discover(seed, Base::Linear, 0.08, 0.5, 0.15, "");
-        let mut named = s.discovery.accepted();
-        named.sort_unstable();
-        assert_eq!(
-            named,
-            ["coulomb_bearing", "viscous_quadratic"],
-            "design {seed}"
+    base_missing_drag_and_bearing_names_both(1_606_201);
+}
+
+/// The same rig on a second drawn design (`stribeck` k=1 at seed 15): there the bearing friction
+/// was judged first and refused as a partial explanation, and the drag then as a freer shape's
+/// part; both are named as a pair.
+#[test]
+#[ignore = "slow set (a second drawn design, 9 s on 2 cores; moved when the default suite took 14:42 of tests on 2 cores alone): the default suite names the pair from the same route, a missing term refused as a partial explanation beside its partner's shape, on independent::issue_12_independent_i01_with_the_linear_base_names_the_drag_and_the_bearing_friction, and from the run-spread route on a_base_missing_two_terms_names_both_where_each_alone_is_a_partial_explanation; README, Tests"]
+fn a_base_missing_two_terms_names_both_on_a_second_design() {
+    base_missing_drag_and_bearing_names_both(1_506_201);
+}
+
+/// Discover with the linear base on a rig with a = 0.08 kg/m and μ = 0.15 names exactly the two
+/// missing terms, each within 10 %.
+fn base_missing_drag_and_bearing_names_both(seed: u64) {
+    let s = discover(seed, Base::Linear, 0.08, 0.5, 0.15, "");
+    let mut named = s.discovery.accepted();
+    named.sort_unstable();
+    assert_eq!(
+        named,
+        ["coulomb_bearing", "viscous_quadratic"],
+        "design {seed}"
+    );
+    for (effect, truth) in [("viscous_quadratic", 0.08), ("coulomb_bearing", 0.15)] {
+        let row = s.discovery.row(effect).unwrap();
+        assert!(
+            (row.estimate - truth).abs() <= 0.10 * truth,
+            "design {seed}, {effect}: {} against {truth}; {}",
+            row.estimate,
+            row.note
         );
-        for (effect, truth) in [("viscous_quadratic", 0.08), ("coulomb_bearing", 0.15)] {
-            let row = s.discovery.row(effect).unwrap();
-            assert!(
-                (row.estimate - truth).abs() <= 0.10 * truth,
-                "design {seed}, {effect}: {} against {truth}; {}",
-                row.estimate,
-                row.note
-            );
-        }
     }
 }
 
