@@ -4901,15 +4901,36 @@ pub fn discover(
         // whose shape acts over the whole swing, both views agree: over the 15 survey draws the
         // screen was within 3.1 % and the refit within 3.0 %.)
         let shaped_by_trajectories = c.shaped().is_some() && refit_est.is_finite();
-        let trajectories_value = second_look || shaped_by_trajectories;
+        // A torque of many lobes per turn (more than `HAT_QUADRATURE_MAX_LOBES`, a cogging
+        // torque) moves the pendulum by less than an encoder count over a lobe where its columns
+        // are large, near the turning points, and the counts erase that detail from the equation
+        // error's target: on an exact 200 Hz free decay the screen reads a 61-lobe torque at 0.67
+        // of its size from the angle in counts and at 1.01 from the exact angle (weak.rs test
+        // `a_many_lobed_torque_reads_low_through_the_encoders_counts`). Its trajectories compare
+        // the simulated motion with the counts themselves, and read it without that bias: on the
+        // every-effect survey's many-lobed draws (k 8–61, drawn seeds 20–25) the screen was low by
+        // 2.0 % on average and 12.1 % at worst (a 61-lobe torque, `SURVEY_DAMPING=drawn
+        // SURVEY_SEED=23`, `position_torque` k=0), the refit off by 0.1 % on average and 6.5 % at
+        // worst. So its value is theirs where they tell it from its absence (`informative`), as
+        // on the second look; the verdict is the screen's route's, unchanged.
+        let many_lobed = c.add.iter().any(|&col| {
+            crate::weak::columns()
+                .get(col)
+                .is_some_and(|k| k.reg.lobes > crate::weak::HAT_QUADRATURE_MAX_LOBES)
+        });
+        let counts_blur_screen =
+            many_lobed && informative && !(silent || lag_silent) && refit_est.is_finite();
+        let trajectories_value = second_look || shaped_by_trajectories || counts_blur_screen;
         // On the second look, where the trajectories tell the size from its absence and the
         // model judged carries their value (not the screen's, `silent`, `lag_silent`), they are
         // the view that named it, and its interval is theirs too. The screen's interval widened
         // to hold their value said [−1.7, 4.2] N·m for a breakaway named at 1.2e-2 N·m on its
         // trajectories (`SURVEY_DAMPING=drawn SURVEY_SEED=3`, `stribeck` k=4): a named effect
         // whose own interval held its absence.
-        let named_by_trajectories =
-            second_look && informative && !(silent || lag_silent) && refit_est.is_finite();
+        let named_by_trajectories = (second_look || counts_blur_screen)
+            && informative
+            && !(silent || lag_silent)
+            && refit_est.is_finite();
         // Its named value's own interval, from the view that gave it.
         let refit_range = match size_index {
             Some(i) if accepted && (shaped_by_trajectories || named_by_trajectories) => {
@@ -5201,6 +5222,12 @@ pub fn discover(
             row.note.push_str(&format!(
                 "; the validate runs' equation error cannot see it (were it true at the screen's size, it would fall {:.1} %, short of its bar): it neither confirms nor contradicts, and E_θ judges it",
                 100.0 * reach
+            ));
+        }
+        if counts_blur_screen && !second_look && accepted {
+            row.note.push_str(&format!(
+                "; a torque of {} lobes per turn moves the pendulum by less than an encoder count over a lobe, and the counts read its size low on the equation error: the estimate is the trajectory refit's (the screen's {est:.4e} {unit})",
+                c.k
             ));
         }
         if shaped_by_trajectories && !second_look {
