@@ -4908,11 +4908,12 @@ pub fn discover(
         // of its size from the angle in counts and at 1.01 from the exact angle (weak.rs test
         // `a_many_lobed_torque_reads_low_through_the_encoders_counts`). Its trajectories compare
         // the simulated motion with the counts themselves, and read it without that bias: on the
-        // every-effect survey's many-lobed draws (k 8–61, drawn seeds 20–25) the screen was low by
-        // 2.0 % on average and 12.1 % at worst (a 61-lobe torque, `SURVEY_DAMPING=drawn
-        // SURVEY_SEED=23`, `position_torque` k=0), the refit off by 0.1 % on average and 6.5 % at
-        // worst. So its value is theirs where they tell it from its absence (`informative`), as
-        // on the second look; the verdict is the screen's route's, unchanged.
+        // every-effect survey's 26 named many-lobed draws (k 8–61, `SURVEY_DAMPING=drawn`, seeds
+        // 20–25) the screen read 1.5 % low on average (18 of 26 low) and 12.1 % low at worst (a
+        // 61-lobe torque, seed 23, `position_torque` k=0), the identify runs' refit 0.3 % low on
+        // average and 6.5 % off at worst. So its value is theirs where they tell it from its
+        // absence (`informative`), as on the second look; the verdict is the screen's route's,
+        // unchanged.
         let many_lobed = c.add.iter().any(|&col| {
             crate::weak::columns()
                 .get(col)
