@@ -4911,16 +4911,19 @@ pub fn discover(
         // every-effect survey's 26 named many-lobed draws (k 8–61, `SURVEY_DAMPING=drawn`, seeds
         // 20–25) the screen read 1.5 % low on average (18 of 26 low) and 12.1 % low at worst (a
         // 61-lobe torque, seed 23, `position_torque` k=0), the identify runs' refit 0.3 % low on
-        // average and 6.5 % off at worst. So its value is theirs where they tell it from its
-        // absence (`informative`), as on the second look; the verdict is the screen's route's,
-        // unchanged.
+        // average and 6.5 % off at worst. So a named one's value is theirs where they tell it
+        // from its absence (`informative`), as on the second look; the verdict is the screen's
+        // route's, unchanged, and a refused one's row keeps the screen's value it was judged at.
         let many_lobed = c.add.iter().any(|&col| {
             crate::weak::columns()
                 .get(col)
                 .is_some_and(|k| k.reg.lobes > crate::weak::HAT_QUADRATURE_MAX_LOBES)
         });
-        let counts_blur_screen =
-            many_lobed && informative && !(silent || lag_silent) && refit_est.is_finite();
+        let counts_blur_screen = accepted
+            && many_lobed
+            && informative
+            && !(silent || lag_silent)
+            && refit_est.is_finite();
         let trajectories_value = second_look || shaped_by_trajectories || counts_blur_screen;
         // On the second look, where the trajectories tell the size from its absence and the
         // model judged carries their value (not the screen's, `silent`, `lag_silent`), they are
@@ -5225,7 +5228,7 @@ pub fn discover(
                 100.0 * reach
             ));
         }
-        if counts_blur_screen && !second_look && accepted {
+        if counts_blur_screen && !second_look {
             row.note.push_str(&format!(
                 "; a torque of {} lobes per turn moves the pendulum by less than an encoder count over a lobe, and the counts read its size low on the equation error: the estimate is the trajectory refit's (the screen's {est:.4e} {unit})",
                 c.k
