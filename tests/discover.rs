@@ -1383,6 +1383,36 @@ fn a_position_torque_whose_rest_angles_the_free_decays_do_not_follow_is_not_name
     assert!(row.note.contains("stands in for an offset"), "{}", row.note);
 }
 
+/// The every-effect survey's `encoder_offset` k=0 at `SURVEY_DAMPING=drawn SURVEY_SEED=26`: a
+/// 7.03e-2 rad offset on a design whose runs all rest and share one bob mass (rods 0.17–0.26 m).
+/// A k = 1 position torque was named first (1.06e-1 N·m), its rest angles by rod length too
+/// close to the four free decays' one angle to refuse it as an offset; the offset, named next,
+/// took the torque's refit to 9.2e-3 N·m. Judged again beside the offset, the torque is dropped
+/// and the offset alone is named.
+#[test]
+#[ignore = "slow set (a survey draw: `encoder_offset` k=0 at SURVEY_DAMPING=drawn SURVEY_SEED=26, 14 s): the default suite checks the rule's parts on the pendulum-discover unit tests a_name_is_superseded_only_below_half_its_value_and_outside_its_intervals and an_effect_taken_out_of_a_model_leaves_the_rest_in_order; README, Tests"]
+fn a_name_that_stood_in_for_a_later_one_is_dropped_when_judged_beside_it() {
+    let truth = 0.07034692980137355;
+    let s = discover(
+        2_605_800,
+        Base::Reference,
+        0.08246545295399342,
+        0.40896949682298245,
+        0.16055535970817741,
+        &format!("encoder_offset_rad = {truth}"),
+    );
+    assert_found(&s, "encoder_offset", truth, 0.0, 2e-3);
+    let row = s
+        .discovery
+        .row("position_torque")
+        .expect("a position_torque row");
+    assert!(
+        row.note.contains("stood in for encoder_offset"),
+        "{}",
+        row.note
+    );
+}
+
 /// Nothing hidden on a drawn design of mixed bobs (the false-alarm survey's campaign 48 at
 /// `SURVEY_DAMPING=drawn SURVEY_SEED=33`). The screen offered a k = 1 position torque of
 /// 1.6e-4 N·m, which tilts the lightest bob's rest (m g l = 1.73 N·m) by 0.06 of an encoder
