@@ -1441,6 +1441,33 @@ fn a_shaped_effect_whose_views_disagree_at_the_screens_shape_is_compared_at_the_
     );
 }
 
+/// The every-effect survey's `encoder_offset` k=2 at `SURVEY_DAMPING=drawn SURVEY_SEED=27`: a
+/// −3.35e-2 rad offset on a design whose moving identify runs rotate or tumble. The screen read
+/// it at −3.41e-2 but could not tell it from 0 ([−8.1e-2, 1.3e-2], ΔBIC +3.5), so it never
+/// joined the search, while the five identify runs' free decays swung about −0.030 to −0.036
+/// rad. The free decays' centres read it directly: it is judged, and named within 2 mrad.
+#[test]
+#[ignore = "slow set (a survey draw: `encoder_offset` k=2 at SURVEY_DAMPING=drawn SURVEY_SEED=27, 40 s): the default suite reads an offset from the free decays' centres on an_offset_the_free_decays_hang_at_is_named_where_the_screen_holds_it_loosely; README, Tests"]
+fn an_offset_the_screen_cannot_see_joins_the_search_where_the_free_decays_read_it() {
+    let truth = -0.03351372798360833;
+    let s = discover(
+        2_705_802,
+        Base::Reference,
+        0.01956008218262042,
+        0.697438934707135,
+        0.13099046880065843,
+        &format!("encoder_offset_rad = {truth}"),
+    );
+    assert_found(&s, "encoder_offset", truth, 0.0, 2e-3);
+    let row = s.discovery.row("encoder_offset").unwrap();
+    assert!(row.delta_bic > -10.0, "ΔBIC {}", row.delta_bic);
+    assert!(
+        row.note.contains("the free decays' centres"),
+        "{}",
+        row.note
+    );
+}
+
 /// Nothing hidden on a drawn design of mixed bobs (the false-alarm survey's campaign 48 at
 /// `SURVEY_DAMPING=drawn SURVEY_SEED=33`). The screen offered a k = 1 position torque of
 /// 1.6e-4 N·m, which tilts the lightest bob's rest (m g l = 1.73 N·m) by 0.06 of an encoder
