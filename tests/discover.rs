@@ -2178,6 +2178,50 @@ fn a_tilt_the_resting_pendulum_hides_from_the_equation_error_is_read_by_the_acce
     );
 }
 
+/// The every-effect survey's pair 1 at `SURVEY_DAMPING=drawn SURVEY_SEED=27`: a 13.9 ms lag
+/// beside a −7.61e-2 rad tilted guide. The screen took the tilt first at −6.59e-2 [−7.31e-2,
+/// −5.86e-2] (ΔBIC −228), the lag unmodelled beside it, while every forced run's accelerometer
+/// read −7.61e-2 [−7.64e-2, −7.57e-2]; the tilt was refused as "the guide is not tilted so" and
+/// nothing was named. The accelerometer's reading, judged first by the pendulum, is named; with
+/// its torque known the lag is screened again and named; both within 10 %.
+#[test]
+#[ignore = "slow set (a survey draw: pair 1 at SURVEY_DAMPING=drawn SURVEY_SEED=27, 38 s): the default suite judges the accelerometer's tilt first on a_tilt_the_resting_pendulum_hides_from_the_equation_error_is_read_by_the_accelerometer; README, Tests"]
+fn a_tilt_whose_screen_the_accelerometer_refuses_is_judged_first_and_the_lag_beside_it_named() {
+    let (lag, tilt) = (0.013859282889249964, -0.07607171794714387);
+    let s = discover(
+        2_707_001,
+        Base::Reference,
+        0.0,
+        0.5,
+        0.15,
+        &format!("accel_delay_s = {lag}\nhorizontal_base_delta_rad = {tilt}"),
+    );
+    let mut accepted = s.discovery.accepted();
+    accepted.sort_unstable();
+    assert_eq!(
+        accepted,
+        ["accel_delay", "horizontal_base"],
+        "{:#?}",
+        s.discovery.rows
+    );
+    for (effect, truth) in [("accel_delay", lag), ("horizontal_base", tilt)] {
+        let row = s.discovery.row(effect).unwrap();
+        assert!(
+            (row.estimate - truth).abs() <= 0.10 * truth.abs(),
+            "{effect}: {:.4e} against {truth:.4e}",
+            row.estimate
+        );
+    }
+    let row = s.discovery.row("horizontal_base").unwrap();
+    assert!(
+        row.note
+            .contains("is refused by the accelerometer's reading")
+            && row.note.contains("judged before the search"),
+        "{}",
+        row.note
+    );
+}
+
 /// The every-effect survey's pair 2 at `SURVEY_SEED=11` (0.0422 rad and 1.31e-2 kg·m²; three
 /// validate runs resting under their shakers, the base fit pinned at μ = 0.25). The inertia,
 /// screened first (ΔBIC −1636), was refused because the validate runs' own rows put it at
