@@ -1468,6 +1468,34 @@ fn an_offset_the_screen_cannot_see_joins_the_search_where_the_free_decays_read_i
     );
 }
 
+/// The every-effect survey's `encoder_offset` k=1 at `SURVEY_DAMPING=drawn SURVEY_SEED=28`: a
+/// 2.08e-2 rad offset on a design whose identify runs all rest, the base fit pinned at μ's bound,
+/// so judged on the second look. Refitted at 1.94e-2, it took 93.5 % ± 48.4 % off the validate
+/// runs' E_θ, short of twice its bar, and was reported `unexplained`, while every run's free
+/// decay, identify and validate, swung about +0.019 to +0.028 rad. The validate runs' centres
+/// are a held-out view of the offset alone: they confirm it, and it is named within 2 mrad.
+#[test]
+#[ignore = "slow set (a survey draw: `encoder_offset` k=1 at SURVEY_DAMPING=drawn SURVEY_SEED=28, 30 s): the default suite reads an offset from the free decays' centres on an_offset_the_free_decays_hang_at_is_named_where_the_screen_holds_it_loosely; README, Tests"]
+fn an_offset_on_the_second_look_is_confirmed_by_the_validate_runs_free_decays() {
+    let truth = 0.02080170964145733;
+    let s = discover(
+        2_805_801,
+        Base::Reference,
+        0.028751309216605736,
+        0.6690491573997093,
+        0.13927566541703032,
+        &format!("encoder_offset_rad = {truth}"),
+    );
+    assert_found(&s, "encoder_offset", truth, 0.0, 2e-3);
+    let row = s.discovery.row("encoder_offset").unwrap();
+    assert!(
+        row.note
+            .contains("the validate runs' own free decays confirm it"),
+        "{}",
+        row.note
+    );
+}
+
 /// Nothing hidden on a drawn design of mixed bobs (the false-alarm survey's campaign 48 at
 /// `SURVEY_DAMPING=drawn SURVEY_SEED=33`). The screen offered a k = 1 position torque of
 /// 1.6e-4 N·m, which tilts the lightest bob's rest (m g l = 1.73 N·m) by 0.06 of an encoder
