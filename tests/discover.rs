@@ -1516,6 +1516,35 @@ fn an_offset_on_the_second_look_is_confirmed_by_the_validate_runs_free_decays() 
     );
 }
 
+/// The every-effect survey's `extra_inertia` k=2 at `SURVEY_DAMPING=drawn SURVEY_SEED=30`: a
+/// 9.42e-3 kg·m² inertia, named within 0.1 %, and beside it a breakaway the rig does not have,
+/// screened at 6.92e-2 N·m at v_s 0.053 rad/s (its band over every shape [1.25e-2, 0.568]) and
+/// refitted at 2.72e-2 at v_s 0.050, where the identify runs' equation error read 7.57e-2 ±
+/// 3.14e-2. The band held the refit; the equation error at the refit's own shape did not, the
+/// trajectories held the breakaway within [0, 8.2e-2], and the validate runs' E_θ fell 6.8 % ±
+/// 15.2 %: its size rested on the equation error alone. The inertia alone is named.
+#[test]
+#[ignore = "slow set (a survey draw: `extra_inertia` k=2 at SURVEY_DAMPING=drawn SURVEY_SEED=30, 40 s): the default suite names breakaways whose views agree at one shape on a_breakaway_whose_two_views_overlap_at_the_trajectories_shape_is_named and a_named_breakaway_is_sized_on_every_runs_trajectories; README, Tests"]
+fn a_breakaway_whose_refit_the_equation_error_at_its_shape_does_not_hold_needs_e_theta() {
+    let truth = 0.009421826163460953;
+    let s = discover(
+        3_005_702,
+        Base::Reference,
+        0.051714058020628985,
+        0.5285441301869236,
+        0.18847592462027452,
+        &format!("extra_inertia_j_kg_m2 = {truth}"),
+    );
+    assert_found(&s, "extra_inertia", truth, 0.10, 0.0);
+    let row = s.discovery.row("stribeck").expect("a stribeck row");
+    assert!(
+        row.note
+            .contains("not in the identify runs' equation-error interval at the refit's own shape"),
+        "{}",
+        row.note
+    );
+}
+
 /// Nothing hidden on a drawn design of mixed bobs (the false-alarm survey's campaign 48 at
 /// `SURVEY_DAMPING=drawn SURVEY_SEED=33`). The screen offered a k = 1 position torque of
 /// 1.6e-4 N·m, which tilts the lightest bob's rest (m g l = 1.73 N·m) by 0.06 of an encoder
