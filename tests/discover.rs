@@ -1524,7 +1524,7 @@ fn an_offset_on_the_second_look_is_confirmed_by_the_validate_runs_free_decays() 
 /// trajectories held the breakaway within [0, 8.2e-2], and the validate runs' E_θ fell 6.8 % ±
 /// 15.2 %: its size rested on the equation error alone. The inertia alone is named.
 #[test]
-#[ignore = "slow set (a survey draw: `extra_inertia` k=2 at SURVEY_DAMPING=drawn SURVEY_SEED=30, 40 s): the default suite names breakaways whose views agree at one shape on a_breakaway_whose_two_views_overlap_at_the_trajectories_shape_is_named and a_named_breakaway_is_sized_on_every_runs_trajectories; README, Tests"]
+#[ignore = "slow set (a survey draw: `extra_inertia` k=2 at SURVEY_DAMPING=drawn SURVEY_SEED=30, 10 s): the default suite names breakaways whose views agree at one shape on a_breakaway_whose_two_views_overlap_at_the_trajectories_shape_is_named and a_named_breakaway_is_sized_on_every_runs_trajectories; README, Tests"]
 fn a_breakaway_whose_refit_the_equation_error_at_its_shape_does_not_hold_needs_e_theta() {
     let truth = 0.009421826163460953;
     let s = discover(
