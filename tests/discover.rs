@@ -2328,6 +2328,29 @@ fn a_first_whose_sizes_the_others_absence_splits_is_named_in_a_pair() {
     );
 }
 
+/// The every-effect survey's pair 2 at `SURVEY_SEED=31` (a 6.76e-2 rad offset and a 7.85e-3
+/// kg·m² inertia): the offset was read at 6.56e-2 on the identify runs and 6.67e-2 on the
+/// validate runs, and named at every run's 6.10e-2 (−9.8 %) with an interval of [−2.7, 2.8] rad,
+/// the runs' zeroing contrasts scattering once both chaotic runs joined. Every run's value now
+/// replaces the identify runs' only where it is at least as precise: the offset is named at the
+/// identify runs' value, its interval theirs.
+#[test]
+#[ignore = "slow set (a survey draw: pair 2 at SURVEY_SEED=31, 21 s): the default suite names the pair on a_first_whose_sizes_the_others_absence_splits_is_named_in_a_pair; README, Tests"]
+fn every_runs_value_is_named_only_where_it_is_as_precise_as_the_identify_runs() {
+    let (s, t_off) = offset_and_inertia_pair(3_100_000);
+    let row = s.discovery.row("encoder_offset").unwrap();
+    assert!(
+        (row.estimate / t_off - 1.0).abs() <= 0.05
+            && row.ci_low <= t_off
+            && t_off <= row.ci_high
+            && row.ci_high - row.ci_low < 0.1,
+        "offset {:.4e} [{:.4e}, {:.4e}] against {t_off:.4e}",
+        row.estimate,
+        row.ci_low,
+        row.ci_high
+    );
+}
+
 /// The every-effect survey's pair 2 (an encoder offset and an extra inertia, the study's
 /// damping) at seed offset `off`: both named and nothing else, the offset within 2 mrad and the
 /// inertia within 10 %.
