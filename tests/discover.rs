@@ -2351,6 +2351,45 @@ fn every_runs_value_is_named_only_where_it_is_as_precise_as_the_identify_runs() 
     );
 }
 
+/// The every-effect survey's pair 3 at `SURVEY_SEED=31`: a 3.51e-2 rad tilt beside a 1.01e-2 N·m
+/// dry torque. The tilt was screened at 3.485e-2, the identify runs' accelerometers reading
+/// 3.503e-2 [3.49e-2, 3.51e-2], and refused because the validate runs' rows, the dry torque
+/// missing from them, put it at 2.68e-2 [2.05e-2, 3.31e-2]; nothing was named. The validate
+/// runs' own accelerometers read the guide directly: where they hold the screen's tilt too, the
+/// rows' other size says something else is missing, and the tilt is named within 1 %. (The dry
+/// torque beside it stays refused: its identify and validate rows put it at 1.016e-2 and 1.139e-2,
+/// 12 % apart, their intervals just apart.)
+#[test]
+#[ignore = "slow set (a survey draw: pair 3 at SURVEY_SEED=31, 40 s): the default suite names a tilt from the accelerometer on independent::issue_12_independent_i04_horizontal_base; README, Tests"]
+fn a_tilt_the_validate_runs_accelerometers_read_is_not_refused_by_their_rows_size() {
+    let mut r = rng(3_103_003);
+    let (_, s1, _, _, _, _) = draw("coulomb_constant", &mut r);
+    let (t_tilt, s2, _, _, _, _) = draw("horizontal_base", &mut r);
+    let s = discover(
+        3_107_003,
+        Base::Reference,
+        0.0,
+        0.5,
+        0.15,
+        &format!("{s1}\n{s2}"),
+    );
+    let row = s.discovery.row("horizontal_base").unwrap();
+    assert!(
+        row.accepted && (row.estimate / t_tilt - 1.0).abs() <= 0.01,
+        "tilt {:.4e} against {t_tilt:.4e}: {}",
+        row.estimate,
+        row.note
+    );
+    assert!(
+        s.discovery
+            .accepted()
+            .iter()
+            .all(|e| ["horizontal_base", "coulomb_constant"].contains(e)),
+        "{:?}",
+        s.discovery.accepted()
+    );
+}
+
 /// The every-effect survey's pair 2 (an encoder offset and an extra inertia, the study's
 /// damping) at seed offset `off`: both named and nothing else, the offset within 2 mrad and the
 /// inertia within 10 %.
