@@ -3794,6 +3794,7 @@ fn an_offset_the_free_decays_hang_at_is_named_where_the_screen_holds_it_loosely(
 /// 3.8e-4 N·m. A candidate that stands in for the others is not named; the inertia and the
 /// offset are, the offset within 2 mrad and the inertia within 10 %.
 #[test]
+#[ignore = "slow set (a survey pair at SURVEY_SEED=3, 50 s beside other runs; moved out of the default suite in the sixty-first session, whose default suite took 14:50 alone): the default suite checks the rule on the pendulum-discover unit test a_candidate_stands_in_only_where_both_sets_put_it_under_a_tenth_of_its_named_size and names the pair on a_first_whose_sizes_the_others_absence_splits_is_named_in_a_pair; README, Tests"]
 fn a_position_torque_standing_in_for_an_offset_and_an_inertia_is_not_named() {
     offset_and_inertia_pair_is_named(300_000);
 }

@@ -6586,6 +6586,36 @@ mod tests {
     /// more than the promised 10 % apart: a bouncing bob's 7.18e-3 against 2.48e-2 kg·m² do;
     /// overlapping intervals do not, nor do two tight ones 3 % apart (a systematic difference
     /// within the accuracy promised), nor a wide held-out interval that cannot say.
+    /// The every-effect survey's offset + inertia pair at `SURVEY_SEED=3`: a k = 1 position
+    /// torque named at 0.41 N·m, which beside the two the identify rows put at 3.5e-4 [0.9e-4,
+    /// 6.0e-4] and the validate rows at 3.8e-4 [−3.7e-4, 11.3e-4], stands in for them (the draw
+    /// itself is the slow-set test
+    /// `a_position_torque_standing_in_for_an_offset_and_an_inertia_is_not_named`).
+    #[test]
+    fn a_candidate_stands_in_only_where_both_sets_put_it_under_a_tenth_of_its_named_size() {
+        assert!(stands_in_for_others(
+            0.41,
+            (3.5e-4, 2.55e-4),
+            (3.8e-4, 7.5e-4)
+        ));
+        // A set whose interval holds the named value (others collinear with it: wide) does not
+        // refuse it.
+        assert!(!stands_in_for_others(
+            0.41,
+            (3.5e-4, 2.55e-4),
+            (3.8e-4, 0.5)
+        ));
+        // Nor one that puts it at more than a tenth of that value.
+        assert!(!stands_in_for_others(0.41, (0.2, 0.01), (3.8e-4, 7.5e-4)));
+        // Nothing named, nothing stood in for; symmetric in the sign.
+        assert!(!stands_in_for_others(0.0, (0.0, 1e-4), (0.0, 1e-4)));
+        assert!(stands_in_for_others(
+            -0.41,
+            (-3.5e-4, 2.55e-4),
+            (3.8e-4, 7.5e-4)
+        ));
+    }
+
     #[test]
     fn sizes_disagree_only_apart_beyond_both_intervals_and_the_promised_accuracy() {
         assert!(sizes_disagree(7.18e-3, 2.81e-3, 2.48e-2, 8.61e-3));
