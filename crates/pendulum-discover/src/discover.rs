@@ -4305,8 +4305,8 @@ pub fn discover(
         // same shape reads another size: the band holds the refit only where the identify runs'
         // equation error at the refit's shape holds it too, within its interval or 10 % as the
         // views' agreement asks (a generator's interval there can be far narrower than the
-        // difference a slightly other ω_d makes: 2.05e-2 N·m·s/rad refitted within 0.3 % of a
-        // screen within 0.6 % of the truth; on the screen's route; the second
+        // difference a slightly other ω_d makes: a 2.06e-2 N·m·s/rad generator screened at
+        // +0.6 % and refitted at −0.3 % of the truth, 0.8 % apart; on the screen's route; the second
         // look compares the two at that shape by its own rule, `shape_views_agree`). Where it
         // does not, the size rests on one view, and the validate runs' E_θ must confirm it, as
         // below. Beside a hidden 9.42e-3 kg·m² extra inertia (`SURVEY_DAMPING=drawn
