@@ -2329,13 +2329,16 @@ fn a_first_whose_sizes_the_others_absence_splits_is_named_in_a_pair() {
 }
 
 /// The every-effect survey's pair 2 at `SURVEY_SEED=31` (a 6.76e-2 rad offset and a 7.85e-3
-/// kg·m² inertia): the offset was read at 6.56e-2 on the identify runs and 6.67e-2 on the
+/// kg·m² inertia): the offset is read at 6.56e-2 on the identify runs and 6.67e-2 on the
 /// validate runs, and named at every run's 6.10e-2 (−9.8 %) with an interval of [−2.7, 2.8] rad,
-/// the runs' zeroing contrasts scattering once both chaotic runs joined. Every run's value now
-/// replaces the identify runs' only where it is at least as precise: the offset is named at the
-/// identify runs' value, its interval theirs.
+/// the runs' zeroing contrasts scattering once both chaotic runs join. Tried in the sixty-first
+/// session (c8ef79b) and reverted: every run's value replacing the identify runs' only where its
+/// standard error is no larger. That named this offset at 6.56e-2 and passed this test, but it
+/// took the slow-set draw of `a_position_torque_whose_rest_angles_the_free_decays_do_not_follow_
+/// is_not_named_for_an_offset` from within 2 mrad to 2.26 mrad (the identify runs' 4.556e-2
+/// against 4.782e-2; every run's value, with a wider interval, had been nearer).
 #[test]
-#[ignore = "slow set (a survey draw: pair 2 at SURVEY_SEED=31, 21 s): the default suite names the pair on a_first_whose_sizes_the_others_absence_splits_is_named_in_a_pair; README, Tests"]
+#[ignore = "known failure (issue 12) since it was drawn in the sixty-first session: the offset named at every run's 6.10e-2 rad (−9.8 %), its interval ±2.8 rad; a precision guard that mended it (c8ef79b) was reverted, see the doc comment"]
 fn every_runs_value_is_named_only_where_it_is_as_precise_as_the_identify_runs() {
     let (s, t_off) = offset_and_inertia_pair(3_100_000);
     let row = s.discovery.row("encoder_offset").unwrap();

@@ -5259,16 +5259,7 @@ pub fn discover(
                 .map(|x| (x[i], f64::NAN))
             })
         } else {
-            // Every run's value replaces the identify runs' only where it is at least as precise
-            // by the same measure (the same columns and refinement on their rows alone): more
-            // runs that one size describes narrow its interval, and a wider one says the pooling
-            // did not add to it. A hidden 6.76e-2 rad offset beside a 7.85e-3 kg·m² inertia
-            // (`SURVEY_DAMPING=drawn SURVEY_SEED=31`, the every-effect survey's pair 2) was read
-            // at 6.56e-2 on the identify runs and 6.67e-2 on the validate runs, and named at
-            // every run's 6.10e-2 with an interval of [−2.7, 2.8] rad.
-            screen_on(&cols, FitOn::Every).filter(|&(_, se_all)| {
-                screen_on(&cols, FitOn::Identify).is_none_or(|(_, se_id)| !(se_all > se_id))
-            })
+            screen_on(&cols, FitOn::Every)
         }
         .filter(|(v, _)| v.is_finite() && physically_possible(&c.effect, *v));
         let (value, (ci_low, ci_high)) = match pooled {
