@@ -2657,6 +2657,7 @@ fn a_lag_the_resting_identify_runs_cannot_estimate_is_not_ruled_out() {
 /// ([0.03840, 0.03847]), which holds those errors as nuisance contrasts, did not count it. The
 /// interval named counts the runs' zeroing scatter, and holds the truth.
 #[test]
+#[ignore = "slow set (a survey draw at SURVEY_SEED=7, 46 s beside other runs; moved out of the default suite in the sixty-second session, whose default suite took 14:57 alone): the default suite checks the rule on the pendulum-discover unit test an_offsets_interval_counts_each_runs_zeroing_error and names an offset end to end on independent::issue_12_independent_i06_encoder_offset; README, Tests"]
 fn a_named_offsets_interval_counts_each_runs_zeroing_error() {
     let (truth, spec, base, a, b, mu) = draw_scaled("encoder_offset", &mut rng(701_802), 1.0, None);
     let s = discover(705_802, base, a, b, mu, &spec);
@@ -3770,6 +3771,7 @@ fn a_lone_views_fall_a_few_heavy_windows_carry_clears_its_margin_by_the_ranks() 
 /// 0"). The free decays' centres are a second, direct view of an offset of the reading: they
 /// tell it from 0 and hold the screen's value, so it is named, within 2 mrad.
 #[test]
+#[ignore = "slow set (a survey draw at SURVEY_DAMPING=drawn SURVEY_SEED=4, 46 s beside other runs; moved out of the default suite in the sixty-second session, whose default suite took 14:57 alone): the default suite checks the rule on the pendulum-discover unit tests free_decay_centres_read_an_offset_within_their_scatter and free_decays_hanging_at_one_angle_over_mixed_bobs_read_as_an_offset; README, Tests"]
 fn an_offset_the_free_decays_hang_at_is_named_where_the_screen_holds_it_loosely() {
     let off = 400_000;
     let (truth, spec, base, a, b, mu) = draw_scaled(
