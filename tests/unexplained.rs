@@ -1026,6 +1026,46 @@ fn an_off_centre_code_disc_is_not_named_a_position_torque_on_the_equation_error_
     assert!(words.contains("θ (mod 2π)"), "{words}");
 }
 
+/// A code disc mounted 6.9e-3 rad off centre (its peak at φ 2.04 rad: the departure survey's
+/// draw 2 at `DEPARTURE_SEED=28`, first drawn on 4d5daef) was named a 7.1e-3 N·m k = 1 position
+/// torque on the validate runs' E_θ (38.2 % ± 30.5 %; their equation error, blind to it, rose
+/// 6.1 %), its screen's interval [2.2e-4, 1.39e-2] barely leaving out 0. The disc's reading
+/// carries ε θ̇² sin(θ − φ), so the k = 1 columns take one size in the windows where the
+/// pendulum moves fast and another where it moves slowly: the identify rows' split stands at
+/// p = 8.8e-6 (a torque of the angle alone has one size at every speed). Nothing named, the
+/// torque's row says why.
+#[test]
+#[ignore = "slow set (a departure survey draw, about a minute; added in the sixty-second session): the default suite checks the rule on the pendulum-discover unit test a_torque_of_the_angle_alone_holds_one_size_at_every_speed and a code disc on an_off_centre_code_disc_is_not_named_a_position_torque_on_the_equation_error_alone; README, Tests"]
+fn an_off_centre_code_disc_is_not_named_a_position_torque_whose_size_follows_the_speed() {
+    refused(
+        "encoder_eccentricity",
+        2,
+        2_800_000,
+        "position_torque",
+        "a torque of the angle alone has one size at every speed",
+    );
+}
+
+/// A code disc mounted 3.3e-3 rad off centre (its peak at φ −0.78 rad: the departure survey's
+/// draw 0 at `DEPARTURE_SEED=25`, first drawn on e34d710) was named a 2.5e-3 N·m k = 1 position
+/// torque (1.3 counts on its lightest bob) on the validate runs' equation error (13.4 % against
+/// 5.9 %) while their E_θ fell 1.8 % ± 11.2 %. Its validate rows put the torque at 1.3e-3 ±
+/// 0.9e-3 N·m in their slow windows and 1.42e-2 ± 0.17e-2 in their fast ones (their split at
+/// p = 4e-14). Nothing named, and the words say the remaining error follows θ (mod 2π).
+#[test]
+#[ignore = "slow set (a departure survey draw, about a minute; added in the sixty-second session): the default suite checks the rule on the pendulum-discover unit test a_torque_of_the_angle_alone_holds_one_size_at_every_speed and a code disc on an_off_centre_code_disc_is_not_named_a_position_torque_on_the_equation_error_alone; README, Tests"]
+fn an_off_centre_code_disc_whose_fast_windows_read_a_larger_torque_is_unexplained() {
+    let d = refused(
+        "encoder_eccentricity",
+        0,
+        2_500_000,
+        "position_torque",
+        "a torque of the angle alone has one size at every speed",
+    );
+    let words = d.unexplained.as_deref().expect("`unexplained` said");
+    assert!(words.contains("θ (mod 2π)"), "{words}");
+}
+
 /// A dry torque growing with time, 5.7e-4 N·m/s (the departure survey's draw 4 at
 /// `DEPARTURE_SEED=11`, first drawn on 5fc8793), was named a k = 1 position torque: screened at
 /// 3.4e-3 N·m [1.8e-3, 5.0e-3], refitted at 1.1e-3, the two "agreeing" only because the

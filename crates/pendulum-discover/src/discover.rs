@@ -731,6 +731,107 @@ pub fn sizes_disagree(identify: f64, identify_half: f64, heldout: f64, heldout_h
     d > identify_half + heldout_half && d > AGREEMENT_REL * identify.abs()
 }
 
+/// Chance below which a torque of the angle alone is refused for not holding one size at every
+/// speed ([`one_size_at_every_speed`]): one in a thousand on either set of rows. On the
+/// every-effect survey's twenty drawn position torques of seeds 28–31 (`SURVEY_DAMPING=drawn`),
+/// all named, each set's p ran from 5.5e-3 (seed 30, k=4, its validate rows) to 0.99.
+pub const ONE_SIZE_AT_EVERY_SPEED_P: f64 = 1e-3;
+
+/// A candidate's rows split by speed ([`one_size_at_every_speed`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct SpeedSplit {
+    /// Chow's F test: the chance of a fall as large from a second size by chance alone.
+    pub p: f64,
+    /// The size (SI) of the difference between the fast windows' torque and the slow ones'.
+    pub apart: f64,
+}
+
+impl SpeedSplit {
+    /// Whether the two sizes differ beyond chance ([`ONE_SIZE_AT_EVERY_SPEED_P`]) and by more
+    /// than [`AGREEMENT_REL`] of the size named (`named`): with a precise screen, a difference
+    /// of a fraction of a per cent is significant and means nothing (`i10_pair`'s 0.03 N·m
+    /// k = 2 torque beside a 0.01 kg·m² inertia, its validate runs r03–r05, split at p = 2.4e-4
+    /// on its identify rows, all within ±0.7 % of the truth).
+    pub fn refuses(&self, named: f64) -> bool {
+        self.p < ONE_SIZE_AT_EVERY_SPEED_P && self.apart > AGREEMENT_REL * named.abs()
+    }
+}
+
+/// Chow's F test of one size at every speed: how often columns `c.add` (a candidate's), given a
+/// second size of their own in the windows where the pendulum moves fast (|θ̇| at the window's
+/// centre above the rows' median), would take as much off the rows' weighted equation error as
+/// they do by chance alone, the other `cols` shared by both halves (`c.add.len()` degrees of
+/// freedom); and how far apart the two torques are. A torque of the angle alone has one size at
+/// every speed; an off-centre code disc reads θ + ε(sin(θ − φ) + sin φ), whose second
+/// derivative carries ε θ̇² sin(θ − φ), so the k = 1 columns take a size that grows with the
+/// speed (a 3.3e-3 rad disc, the departure survey's `encoder_eccentricity` k=0 at
+/// `DEPARTURE_SEED=25`, was named a 2.5e-3 N·m k = 1 position torque: the validate rows put it
+/// at 1.3e-3 ± 0.9e-3 N·m in their slow windows and 1.42e-2 ± 0.17e-2 in their fast ones). The
+/// fast half's copies carry the extra inertia's divisor at the one-size fit's J (a dynamics
+/// column is divided by 1 + J/(m l²) per run). None where the rows cannot tell (a column empty
+/// on them, or a fit that fails).
+pub(crate) fn one_size_at_every_speed(
+    rows: &[WeakRow],
+    cols: &[usize],
+    c: &Candidate,
+) -> Option<SpeedSplit> {
+    let add = &c.add;
+    let effect = pendulum_model::effects::by_name(&c.effect)?;
+    let live = |k: usize| rows.iter().any(|r| r.x.get(k).is_some_and(|v| *v != 0.0));
+    if add.is_empty() || !add.iter().all(|&k| cols.contains(&k) && live(k)) {
+        return None;
+    }
+    let cols: Vec<usize> = cols.iter().copied().filter(|&k| live(k)).collect();
+    let mut speeds: Vec<f64> = rows.iter().map(|r| r.theta_dot_rad_s.abs()).collect();
+    speeds.sort_by(f64::total_cmp);
+    let median = *speeds.get(speeds.len() / 2)?;
+    let one = ols(rows, &cols)?;
+    let width = rows.iter().map(|r| r.x.len()).max()?;
+    let split: Vec<WeakRow> = rows
+        .iter()
+        .map(|r| {
+            let mut r = r.clone();
+            r.x.resize(width, 0.0);
+            let fast = r.theta_dot_rad_s.abs() > median;
+            let divisor = crate::screen::inertia_divisor(&r, one.inertia_kg_m2);
+            let mut copies = vec![0.0; add.len()];
+            if fast {
+                for (copy, &k) in copies.iter_mut().zip(add) {
+                    let v = std::mem::take(&mut r.x[k]);
+                    *copy = if crate::weak::is_dynamics(k) {
+                        v * divisor
+                    } else {
+                        v
+                    };
+                }
+            }
+            r.x.extend(copies);
+            r
+        })
+        .collect();
+    let mut both = cols.clone();
+    both.extend(width..width + add.len());
+    let two = ols(&split, &both)?;
+    let q = add.len() as f64;
+    let df = two.n as f64 - two.columns.len() as f64;
+    if df < 1.0 || !(two.rss > 0.0) || !one.rss.is_finite() {
+        return None;
+    }
+    let f = ((one.rss - two.rss).max(0.0) / q) / (two.rss / df);
+    let difference: Vec<(f64, f64)> = add
+        .iter()
+        .enumerate()
+        .map(|(j, &k)| match (two.coef_of(k), two.coef_of(width + j)) {
+            (Some((s, ss)), Some((f, sf))) => (f - s, ss.hypot(sf)),
+            _ => (f64::NAN, f64::NAN),
+        })
+        .collect();
+    Some(SpeedSplit {
+        p: pendulum_numerics::f_sf(f, q, df),
+        apart: effect.estimate(&difference).0.abs(),
+    })
+}
+
 /// Whether, beside the first round's other candidates, both the identify and the validate rows
 /// put a candidate's size at less than [`AGREEMENT_REL`] of the value it would be named at
 /// (`named`), each interval (value, 95 % half-width) excluding that value: what it explains, the
@@ -4749,23 +4850,23 @@ pub fn discover(
         // (1.78e-2 N·m) was put at 2.26e-2 [2.03e-2, 2.49e-2] by the validate rows of two runs
         // whose own zeros differed by 8 counts, while each of those runs alone said 1.78e-2 and
         // 1.74e-2 (± 0.03e-2), and the torque was refused as following the run.
-        let heldout_size = if accepted && !second_look && c.shaped().is_none() {
-            let mut beside_cols = cols.clone();
-            beside_cols.extend(
-                crate::weak::observation_column()
-                    .filter(|o| effect.kind() != Kind::Observation && !cols.contains(o)),
-            );
-            for other in first_round.iter().filter(|o| {
-                o.candidate.effect != c.effect
-                    && o.candidate.shaped().is_none()
-                    && o.delta_bic < cfg.screen_threshold
-            }) {
-                for &a in &other.candidate.add {
-                    if !beside_cols.contains(&a) {
-                        beside_cols.push(a);
-                    }
+        let mut beside_cols = cols.clone();
+        beside_cols.extend(
+            crate::weak::observation_column()
+                .filter(|o| effect.kind() != Kind::Observation && !cols.contains(o)),
+        );
+        for other in first_round.iter().filter(|o| {
+            o.candidate.effect != c.effect
+                && o.candidate.shaped().is_none()
+                && o.delta_bic < cfg.screen_threshold
+        }) {
+            for &a in &other.candidate.add {
+                if !beside_cols.contains(&a) {
+                    beside_cols.push(a);
                 }
             }
+        }
+        let heldout_size = if accepted && !second_look && c.shaped().is_none() {
             let on = |rows: FitOn| {
                 screen_on(&beside_cols, rows).filter(|(v, s)| v.is_finite() && s.is_finite())
             };
@@ -4823,6 +4924,31 @@ pub fn discover(
             });
         let accel_refuses = accepted && !size_disagrees && !stand_in && accel_disagrees;
         let accepted = accepted && !size_disagrees && !stand_in && !accel_disagrees;
+        // A torque of the angle alone has one size at every speed: each set of rows, beside the
+        // first round's other candidates (as for `heldout_size`), is asked whether a second
+        // size for the windows where the pendulum moves fast does better than chance
+        // ([`one_size_at_every_speed`]). A code disc mounted 6.9e-3 rad off centre (the
+        // departure survey's `encoder_eccentricity` k=2 at `DEPARTURE_SEED=28`) was named a
+        // 7.1e-3 N·m k = 1 position torque on the validate runs' E_θ (38.2 % ± 30.5 %, their
+        // equation error blind to it) while the identify rows' split stood at p = 8.8e-6; a
+        // 3.3e-3 rad one (k=0 at `DEPARTURE_SEED=25`) on the validate runs' equation error, its
+        // validate rows' split at p = 2.0e-10.
+        let speed_split = (accepted && effect.torque_of_the_angle_alone()).then(|| {
+            let id = one_size_at_every_speed(&view.id_rows, &beside_cols, c);
+            let v = View::build_with(
+                ctx,
+                &weak_ctx.alignments,
+                base,
+                &cfg.weak,
+                &correction,
+                FitOn::Validate,
+            );
+            let val = one_size_at_every_speed(&v.id_rows, &v.columns_from(&beside_cols, &view), c);
+            (id, val)
+        });
+        let speed_refuses =
+            speed_split.is_some_and(|(id, val)| id.into_iter().chain(val).any(|s| s.refuses(est)));
+        let accepted = accepted && !speed_refuses;
         // The pair look's second candidate, judged beside the first one held provisionally:
         // the first must not do better refitted away in the model holding both (its E_θ gain
         // beside the second, and the gain's noise).
@@ -5325,6 +5451,8 @@ pub fn discover(
                     "; beside the first round's other candidates, the identify and the validate rows each put its size at under a tenth of this, their intervals excluding it: it stands in for them, not named"
                 } else if accel_refuses {
                     "; the accelerometer's horizontal axis does not move as this tilt would (its reading below): the guide is not tilted so, and the departure is something else, not named"
+                } else if speed_refuses {
+                    "; its size where the pendulum moves fast is not its size where it moves slowly (the rows' split below): a torque of the angle alone has one size at every speed, and the departure is something else, not named"
                 } else if angle_remains && effect.reads_hanging_position() {
                     "; with it in, what remains still follows the unwrapped angle (a torque no offset makes, described below, confirmed on the validate runs), and an offset moves the angle the way part of such a torque does: a partial explanation, not named"
                 } else if angle_remains {
@@ -5501,6 +5629,22 @@ pub fn discover(
                 v + 1.96 * s,
                 e - 1.96 * se,
                 e + 1.96 * se,
+            ));
+        }
+        if let Some((id, val)) = speed_split {
+            let said = |s: Option<SpeedSplit>| {
+                s.map_or("not asked (a column empty on them)".to_string(), |s| {
+                    format!(
+                        "p = {:.2e}, the fast windows' torque {:.4e} {unit} apart from the slow ones'",
+                        s.p, s.apart
+                    )
+                })
+            };
+            row.note.push_str(&format!(
+                "; one size at every speed (a second size where |dθ/dt| is above the rows' median, Chow's F test; refused below p = {ONE_SIZE_AT_EVERY_SPEED_P:.0e} where the two also differ by more than {:.0} % of its size): the identify rows' {}, the validate rows' {}",
+                100.0 * AGREEMENT_REL,
+                said(id),
+                said(val)
             ));
         }
         if let Some((v, _)) = pooled {
@@ -6819,6 +6963,68 @@ mod tests {
     /// the rows would show were it true at the fitted size) matches the fall the rows do show
     /// when it is true, and a torque acting in 3 windows of 400 reaches a share that its own
     /// paired noise swamps, while the same share spread over every window clears it.
+    /// One size at every speed, by construction: 800 windows over θ in (−π, π) and θ̇ in
+    /// (−6, 6) rad/s, a viscous column beside a k = 1 torque's two. A torque of the angle alone
+    /// (0.02 sin θ + 0.01 cos θ, noise of 0.01) holds one size in the fast windows and the slow
+    /// ones; the same torque with an off-centre disc's share, 1e-3 θ̇² sin(θ − 0.7), does not,
+    /// far below the bar; a candidate column empty on the rows asks nothing.
+    #[test]
+    fn a_torque_of_the_angle_alone_holds_one_size_at_every_speed() {
+        let ncol = crate::weak::columns().len();
+        let drag = crate::weak::column_of("viscous_linear").unwrap();
+        let k1 = crate::weak::group_columns("position_torque", 1);
+        assert_eq!(k1.len(), 2);
+        let cols = [drag, k1[0], k1[1]];
+        let mut unit = xorshift_uniform();
+        let mut rows_with = |disc: f64| -> Vec<WeakRow> {
+            (0..800)
+                .map(|i| {
+                    let theta = std::f64::consts::PI * (2.0 * unit() - 1.0);
+                    let rate = 6.0 * (2.0 * unit() - 1.0);
+                    let noise = 0.01 * (2.0 * unit() - 1.0) * 3f64.sqrt();
+                    let mut x = vec![0.0; ncol];
+                    x[drag] = rate;
+                    x[k1[0]] = theta.sin();
+                    x[k1[1]] = theta.cos();
+                    let target = 0.3 * rate
+                        + 0.02 * theta.sin()
+                        + 0.01 * theta.cos()
+                        + disc * rate * rate * (theta - 0.7).sin()
+                        + noise;
+                    let mut r = crate::weak::test_row(i % 4, 0.1, x, target);
+                    r.theta = theta;
+                    r.theta_dot_rad_s = rate;
+                    r
+                })
+                .collect()
+        };
+        let candidate = |k: u32| Candidate {
+            effect: "position_torque".into(),
+            add: crate::weak::group_columns("position_torque", k),
+            replaces: None,
+            k,
+            shape: 0.0,
+            size_band: None,
+        };
+        // The torque named: 0.02 sin θ + 0.01 cos θ, 2.236e-2 N·m.
+        let named = 0.02_f64.hypot(0.01);
+        let alone = one_size_at_every_speed(&rows_with(0.0), &cols, &candidate(1)).unwrap();
+        assert!(alone.p > ONE_SIZE_AT_EVERY_SPEED_P, "{alone:?}");
+        assert!(!alone.refuses(named));
+        let disc = one_size_at_every_speed(&rows_with(1e-3), &cols, &candidate(1)).unwrap();
+        assert!(disc.p < 1e-6 && disc.apart > 0.1 * named, "{disc:?}");
+        assert!(disc.refuses(named));
+        // Beyond chance but within the promised accuracy: not refused.
+        assert!(!SpeedSplit {
+            p: 1e-9,
+            apart: 0.09 * named
+        }
+        .refuses(named));
+        let mut with_k2 = cols.to_vec();
+        with_k2.extend(candidate(2).add);
+        assert!(one_size_at_every_speed(&rows_with(0.0), &with_k2, &candidate(2)).is_none());
+    }
+
     #[test]
     fn a_torque_in_a_few_windows_reaches_less_than_its_noise() {
         let ncol = crate::weak::columns().len();

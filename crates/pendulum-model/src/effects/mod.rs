@@ -432,6 +432,16 @@ pub trait Effect: Sync + std::fmt::Debug {
         false
     }
 
+    /// Whether its torque is a function of the angle alone (no rate, no forcing, no time, no
+    /// sensor): then one size holds in the windows where the pendulum moves fast and in those
+    /// where it moves slowly. A reading error of the angle (an off-centre code disc: its
+    /// reading's second derivative carries θ̇² sin(θ − φ)) or a torque of the rate that the
+    /// angle's columns only approximate does not hold one size there (discover's
+    /// `one_size_at_every_speed`). Default: no.
+    fn torque_of_the_angle_alone(&self) -> bool {
+        false
+    }
+
     /// Whether the accelerometer's x axis reads its size directly: the slope of the horizontal
     /// acceleration on the vertical one over a forced run is the tangent of the size, whether
     /// the pendulum moves or not (rig.md: x horizontal in the pendulum's plane, fixed to the

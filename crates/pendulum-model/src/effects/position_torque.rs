@@ -71,6 +71,9 @@ impl Effect for PositionTorque {
     fn follows(&self) -> &'static [Variable] {
         &[Variable::Angle, Variable::AngleInTurn]
     }
+    fn torque_of_the_angle_alone(&self) -> bool {
+        true
+    }
     /// Under what tilts the lightest-hung bob's rest by one encoder count (T_p ≤ m g l · 2π/4096):
     /// at the hanging position any lobe count pulls by at most T_p, which moves the rest by
     /// T_p/(m g l), and each run's count is zeroed by hand to within a few counts. (On a drawn
