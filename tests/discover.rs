@@ -2122,6 +2122,7 @@ fn an_offset_is_not_named_a_torque_that_leaves_the_base_pinned() {
 /// read it, and that view of the validate runs' equation error (−0.0 %) does not refuse it
 /// there either.
 #[test]
+#[ignore = "slow set (a survey draw at SURVEY_DAMPING=drawn SURVEY_SEED=15, 40 s beside other runs; moved out of the default suite in the sixty-second session, whose default suite took 15:16 alone): since f07531b its offset is named before the second look, where the free decays read it; the default suite names an offset end to end on independent::issue_12_independent_i06_encoder_offset and checks the free decays' reading on the pendulum-discover unit test free_decay_centres_read_an_offset_within_their_scatter; README, Tests"]
 fn an_offset_whose_validate_equation_error_does_not_move_is_not_refused_by_it() {
     let (truth, s) =
         run_as_surveyed_with_damping("encoder_offset", 1_501_802, 1_509_802, 1_505_802);

@@ -476,6 +476,7 @@ fn a_run_that_cannot_be_aligned_is_left_out_not_the_campaign() {
 /// smaller population reaches the bound in a third of the evaluations. Measured (on 01d5b8e's
 /// analysis): two rounds, 2001 generations, μ = 0.395, b = 0.478 at f_obj 5.08.
 #[test]
+#[ignore = "slow set (a drawn design fitted by differential evolution, 42 s beside other runs; moved out of the default suite in the sixty-second session, whose default suite took 15:16 alone): the default suite checks the widening on the pendulum-process unit test a_search_range_widens_where_the_data_push_and_never_past_physics; README, Tests"]
 fn damping_past_the_studys_search_range_is_fitted_not_pinned() {
     const NP: usize = 44;
     let dir = tempfile::tempdir().unwrap();

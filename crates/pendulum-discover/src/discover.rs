@@ -749,9 +749,10 @@ pub(crate) struct SpeedSplit {
 impl SpeedSplit {
     /// Whether the two sizes differ beyond chance ([`ONE_SIZE_AT_EVERY_SPEED_P`]) and by more
     /// than [`AGREEMENT_REL`] of the size named (`named`): with a precise screen, a difference
-    /// of a fraction of a per cent is significant and means nothing (`i10_pair`'s 0.03 N·m
-    /// k = 2 torque beside a 0.01 kg·m² inertia, its validate runs r03–r05, split at p = 2.4e-4
-    /// on its identify rows, all within ±0.7 % of the truth).
+    /// of a few per cent is significant and means nothing (`i10_pair`'s 0.03 N·m k = 2 torque
+    /// beside a 0.01 kg·m² inertia, its validate runs r03–r05, split at p = 2.4e-4 on its
+    /// identify rows, the fast and slow torques 9.3e-4 N·m apart, 3 % of its size, while both
+    /// sets of runs put it within 0.5 % of the truth).
     pub fn refuses(&self, named: f64) -> bool {
         self.p < ONE_SIZE_AT_EVERY_SPEED_P && self.apart > AGREEMENT_REL * named.abs()
     }
@@ -765,8 +766,8 @@ impl SpeedSplit {
 /// every speed; an off-centre code disc reads θ + ε(sin(θ − φ) + sin φ), whose second
 /// derivative carries ε θ̇² sin(θ − φ), so the k = 1 columns take a size that grows with the
 /// speed (a 3.3e-3 rad disc, the departure survey's `encoder_eccentricity` k=0 at
-/// `DEPARTURE_SEED=25`, was named a 2.5e-3 N·m k = 1 position torque: the validate rows put it
-/// at 1.3e-3 ± 0.9e-3 N·m in their slow windows and 1.42e-2 ± 0.17e-2 in their fast ones). The
+/// `DEPARTURE_SEED=25`, was named a 2.5e-3 N·m k = 1 position torque; its validate rows split
+/// at p = 4e-14, their fast windows' torque 1.54e-2 N·m apart from the slow ones'). The
 /// fast half's copies carry the extra inertia's divisor at the one-size fit's J (a dynamics
 /// column is divided by 1 + J/(m l²) per run). None where the rows cannot tell (a column empty
 /// on them, or a fit that fails).
