@@ -2314,6 +2314,7 @@ fn a_tilt_whose_screen_the_accelerometer_refuses_is_judged_first_and_the_lag_bes
 /// value. Both named, each within the 10 % (the offset 4.8 % off, 2.0 mrad: the eight
 /// runs' zeros scatter over 12 mrad), and the pair look says so with the sizes beside.
 #[test]
+#[ignore = "slow set (a survey pair at SURVEY_SEED=11, 72 s beside a per-test timing run; moved out of the default suite in the sixty-second session, whose default suite took 15:11 alone): the default suite checks the sizes' rule on the pendulum-discover unit test sizes_disagree_only_apart_beyond_both_intervals_and_the_promised_accuracy, names an offset beside an inertia on an_offset_beside_an_inertia_is_not_refused_by_a_view_its_runs_zeros_blind and the pair look on a_base_missing_two_terms_names_both_where_each_alone_is_a_partial_explanation; README, Tests"]
 fn a_first_whose_sizes_the_others_absence_splits_is_named_in_a_pair() {
     let (s, t_off) = offset_and_inertia_pair(1_100_000);
     let off_est = s.discovery.row("encoder_offset").unwrap().estimate;
@@ -3800,7 +3801,7 @@ fn an_offset_the_free_decays_hang_at_is_named_where_the_screen_holds_it_loosely(
 /// 3.8e-4 N·m. A candidate that stands in for the others is not named; the inertia and the
 /// offset are, the offset within 2 mrad and the inertia within 10 %.
 #[test]
-#[ignore = "slow set (a survey pair at SURVEY_SEED=3, 50 s beside other runs; moved out of the default suite in the sixty-first session, whose default suite took 14:50 alone): the default suite checks the rule on the pendulum-discover unit test a_candidate_stands_in_only_where_both_sets_put_it_under_a_tenth_of_its_named_size and names the pair on a_first_whose_sizes_the_others_absence_splits_is_named_in_a_pair; README, Tests"]
+#[ignore = "slow set (a survey pair at SURVEY_SEED=3, 50 s beside other runs; moved out of the default suite in the sixty-first session, whose default suite took 14:50 alone): the default suite checks the rule on the pendulum-discover unit test a_candidate_stands_in_only_where_both_sets_put_it_under_a_tenth_of_its_named_size and names an offset beside an inertia on an_offset_beside_an_inertia_is_not_refused_by_a_view_its_runs_zeros_blind; README, Tests"]
 fn a_position_torque_standing_in_for_an_offset_and_an_inertia_is_not_named() {
     offset_and_inertia_pair_is_named(300_000);
 }
