@@ -3793,6 +3793,46 @@ fn an_offset_the_free_decays_hang_at_is_named_where_the_screen_holds_it_loosely(
     );
 }
 
+/// The every-effect survey's dry torque + position torque pair at `SURVEY_SEED=33` (7.66e-3 N·m
+/// and a 3.64e-2 N·m torque of k = 31 lobes): the position torque, passing every other check,
+/// was refused as not holding one size at every speed, its identify rows split at p = 8.6e-5
+/// with the fast windows' torque 5.0e-2 ± 1.3e-2 N·m apart from the slow ones'. A window of a
+/// pendulum turning at 5 rad/s sweeps 8 of its lobes, and its column there is a small
+/// remainder of the lobes averaged away: a torque of more lobes than the fast windows resolve
+/// is not asked. Both are named, each within 10 %.
+#[test]
+#[ignore = "slow set (a survey pair at SURVEY_SEED=33, 6 s alone): the default suite checks the lobes' limit on the pendulum-discover unit test a_torque_of_the_angle_alone_holds_one_size_at_every_speed, and names a 50-lobe torque on a_run_zeroed_off_by_counts_does_not_hide_a_cogging_torque; README, Tests"]
+fn a_many_lobed_torque_beside_a_dry_torque_is_named_whatever_its_fast_windows_read() {
+    let off = 3_300_000;
+    let mut r = rng(3000 + off);
+    let (t_dry, s_dry, ..) = draw("coulomb_constant", &mut r);
+    let (t_pos, s_pos, ..) = draw("position_torque", &mut r);
+    assert!(s_pos.contains("k = 31"), "{s_pos}");
+    let s = discover(
+        7000 + off,
+        Base::Reference,
+        0.0,
+        0.5,
+        0.15,
+        &format!("{s_dry}\n{s_pos}"),
+    );
+    let mut accepted = s.discovery.accepted();
+    accepted.sort_unstable();
+    assert_eq!(
+        accepted,
+        ["coulomb_constant", "position_torque"],
+        "{:#?}",
+        s.discovery.rows
+    );
+    for (effect, truth) in [("coulomb_constant", t_dry), ("position_torque", t_pos)] {
+        let est = s.discovery.row(effect).unwrap().estimate;
+        assert!(
+            (est - truth).abs() <= 0.10 * truth,
+            "{effect} {est:.4e} against {truth:.4e}"
+        );
+    }
+}
+
 /// The every-effect survey's offset + inertia pair at `SURVEY_SEED=3` (0.0365 rad and
 /// 1.29e-2 kg·m², the base fit pinned at μ's bound): the inertia was held back while the base
 /// stayed pinned, the offset refused (its screen beside the base alone, the inertia missing, put

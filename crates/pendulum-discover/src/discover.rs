@@ -753,6 +753,18 @@ pub fn sizes_disagree(identify: f64, identify_half: f64, heldout: f64, heldout_h
 /// of [`OneSize::refuses`] asks.
 pub const ONE_SIZE_P: f64 = 1e-3;
 
+/// The most lobes a torque of the angle may have for its size in the fast windows to be asked
+/// ([`one_size_at_every_speed`]): a weak-form window (0.32 s) of a pendulum turning at 5 rad/s
+/// sweeps 8 lobes of a k = 31 torque, whose column there is then a small remainder of sin kθ
+/// averaged over them, at the mercy of the angle's own errors (k times an encoder count) and
+/// of whatever the model misses; up to 4 lobes a window sweeps about two at that speed, and
+/// an off-centre code disc, the departure the split tells apart, reads as k = 1. A hidden
+/// 3.64e-2 N·m k = 31 torque beside a 7.7e-3 N·m constant dry torque (the every-effect
+/// survey's pair 0 at `SURVEY_DAMPING=drawn SURVEY_SEED=33`) split at p = 8.6e-5 on its
+/// identify rows, the fast windows' torque 5.0e-2 ± 1.3e-2 N·m apart from the slow ones', and
+/// was refused. (The sparse description's library holds sin/cos kθ to the same k.)
+pub const ONE_SIZE_AT_EVERY_SPEED_MAX_K: u32 = 4;
+
 /// A candidate's rows split by speed ([`one_size_at_every_speed`]) or by run
 /// ([`one_size_in_every_run`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -762,6 +774,8 @@ pub(crate) struct OneSize {
     /// How far apart the groups' sizes (SI) are: the fast windows' torque less the slow ones';
     /// the spread (weighted standard deviation) of the runs' own sizes.
     pub apart: f64,
+    /// The standard error of the speed split's difference (NaN for the runs' spread).
+    pub apart_se: f64,
 }
 
 impl OneSize {
@@ -788,12 +802,16 @@ impl OneSize {
 /// at p = 4e-14, their fast windows' torque 1.54e-2 N·m apart from the slow ones'). The
 /// fast half's copies carry the extra inertia's divisor at the one-size fit's J (a dynamics
 /// column is divided by 1 + J/(m l²) per run). None where the rows cannot tell (a column empty
-/// on them, or a fit that fails).
+/// on them, a fit that fails, or more lobes than the fast windows resolve,
+/// [`ONE_SIZE_AT_EVERY_SPEED_MAX_K`]).
 pub(crate) fn one_size_at_every_speed(
     rows: &[WeakRow],
     cols: &[usize],
     c: &Candidate,
 ) -> Option<OneSize> {
+    if c.k > ONE_SIZE_AT_EVERY_SPEED_MAX_K {
+        return None;
+    }
     let mut speeds: Vec<f64> = rows.iter().map(|r| r.theta_dot_rad_s.abs()).collect();
     speeds.sort_by(f64::total_cmp);
     let median = *speeds.get(speeds.len() / 2)?;
@@ -813,6 +831,7 @@ pub(crate) fn one_size_at_every_speed(
     Some(OneSize {
         p: split.p,
         apart: effect.estimate(&difference).0.abs(),
+        apart_se: effect.estimate(&difference).1,
     })
 }
 
@@ -845,6 +864,7 @@ pub(crate) fn one_size_in_every_run(
         / w;
     (sizes.len() >= 2 && var.is_finite()).then_some(OneSize {
         p: split.p,
+        apart_se: f64::NAN,
         apart: var.sqrt(),
     })
 }
@@ -5865,7 +5885,12 @@ pub fn discover(
         }
         let said = |s: Option<OneSize>, apart: &str| {
             s.map_or("not asked (a column empty on them)".to_string(), |s| {
-                format!("p = {:.2e}, {apart} {:.4e} {unit}", s.p, s.apart)
+                let se = if s.apart_se.is_finite() {
+                    format!(" ± {:.2e}", s.apart_se)
+                } else {
+                    String::new()
+                };
+                format!("p = {:.2e}, {apart} {:.4e}{se} {unit}", s.p, s.apart)
             })
         };
         if let Some((id, val)) = speed_split {
@@ -7256,12 +7281,28 @@ mod tests {
         // Beyond chance but within the promised accuracy: not refused.
         assert!(!OneSize {
             p: 1e-9,
-            apart: 0.09 * named
+            apart: 0.09 * named,
+            apart_se: 0.01 * named,
         }
         .refuses(named));
         let mut with_k2 = cols.to_vec();
         with_k2.extend(candidate(2).add);
         assert!(one_size_at_every_speed(&rows_with(0.0), &with_k2, &candidate(2)).is_none());
+        // A torque of more lobes than a fast window resolves is not asked.
+        let many = candidate(ONE_SIZE_AT_EVERY_SPEED_MAX_K + 1);
+        let mut with_many = cols.to_vec();
+        with_many.extend(&many.add);
+        let rows = rows_with(1e-3)
+            .into_iter()
+            .map(|mut r| {
+                for (j, &k) in many.add.iter().enumerate() {
+                    let lobe = f64::from(many.k) * r.theta;
+                    r.x[k] = if j == 0 { lobe.sin() } else { lobe.cos() };
+                }
+                r
+            })
+            .collect::<Vec<_>>();
+        assert!(one_size_at_every_speed(&rows, &with_many, &many).is_none());
     }
 
     /// One size in every run, by construction: 5 runs of 300 windows over θ̇ in (−5, 5) rad/s,
