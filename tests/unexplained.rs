@@ -907,15 +907,14 @@ fn a_cable_anchored_off_the_vertical_is_not_named_an_encoder_offset() {
 /// partial explanation of that torque, whatever the effect: nothing named, the words speak of θ.
 #[test]
 fn a_spring_is_not_named_a_breakaway_the_validate_equation_error_does_not_confirm() {
-    let d = refused(
+    refused_and_said(
         "torsion_spring",
         2,
         2_400_000,
         "stribeck",
         "still follows the unwrapped angle",
+        "θ (unwrapped)",
     );
-    let words = d.unexplained.expect("`unexplained` said");
-    assert!(words.contains("θ (unwrapped)"), "{words}");
 }
 
 /// The same departure drawn at `DEPARTURE_SEED=13` (draw 1: 0.242 N·m/rad anchored at −0.106 rad,
@@ -926,15 +925,14 @@ fn a_spring_is_not_named_a_breakaway_the_validate_equation_error_does_not_confir
 /// explanation of that torque. Nothing named, the offset's row says why, the words speak of θ.
 #[test]
 fn a_cable_whose_rest_an_offset_takes_up_is_not_named_one_beside_the_spring_left() {
-    let d = refused(
+    refused_and_said(
         "anchored_cable",
         1,
         1_300_000,
         "encoder_offset",
         "still follows the unwrapped angle",
+        "θ (unwrapped)",
     );
-    let words = d.unexplained.expect("`unexplained` said");
-    assert!(words.contains("θ (unwrapped)"), "{words}");
 }
 
 /// A bearing whose μ differs from run to run by up to 24 % (the departure survey's draw 0 at
@@ -971,15 +969,14 @@ fn a_friction_that_differs_on_the_validate_runs_is_not_named_a_generator() {
 /// generator's row says why, and the words say the torque follows the run.
 #[test]
 fn a_friction_whose_size_follows_the_run_is_not_named_a_generator() {
-    let d = refused(
+    refused_and_said(
         "mu_run_spread",
         4,
         3_100_000,
         "generator_rectified",
         "its size differs from run to run",
+        "follows the run",
     );
-    let words = d.unexplained.expect("`unexplained` said");
-    assert!(words.contains("follows the run"), "{words}");
 }
 
 /// The same departure drawn at `DEPARTURE_SEED=13` (draw 4: μ × up to 1.30 per run, on mixed
@@ -1041,9 +1038,14 @@ fn an_off_centre_code_disc_is_not_named_a_position_torque_on_the_equation_error_
 /// [`refused`] for the departure survey's off-centre code disc `k` (draws shifted by `off`), the
 /// position torque's row saying `why`, and the words saying the error follows θ (mod 2π).
 fn disc_refused_as_a_torque_and_said(k: u64, off: u64, why: &str) {
-    let d = refused("encoder_eccentricity", k, off, "position_torque", why);
-    let words = d.unexplained.as_deref().expect("`unexplained` said");
-    assert!(words.contains("θ (mod 2π)"), "{words}");
+    refused_and_said(
+        "encoder_eccentricity",
+        k,
+        off,
+        "position_torque",
+        why,
+        "θ (mod 2π)",
+    );
 }
 
 /// A code disc mounted 6.9e-3 rad off centre (its peak at φ 2.04 rad: the departure survey's
@@ -1127,6 +1129,13 @@ fn refused(name: &str, k: u64, off: u64, effect: &str, why: &str) -> pendulum_di
     let row = d.row(effect).unwrap_or_else(|| panic!("no {effect} row"));
     assert!(row.note.contains(why), "{}", row.note);
     d
+}
+
+/// [`refused`], and `unexplained` must speak, its words holding `said`.
+fn refused_and_said(name: &str, k: u64, off: u64, effect: &str, why: &str, said: &str) {
+    let d = refused(name, k, off, effect, why);
+    let words = d.unexplained.expect("`unexplained` said");
+    assert!(words.contains(said), "{words}");
 }
 
 /// Runs the departure survey's campaign `k` of `name` (draws shifted by `off`) and checks that
