@@ -3801,7 +3801,6 @@ fn an_offset_the_free_decays_hang_at_is_named_where_the_screen_holds_it_loosely(
 /// remainder of the lobes averaged away: a torque of more lobes than the fast windows resolve
 /// is not asked. Both are named, each within 10 %.
 #[test]
-#[ignore = "slow set (a survey pair at SURVEY_SEED=33, 6 s alone): the default suite checks the lobes' limit on the pendulum-discover unit test a_torque_of_the_angle_alone_holds_one_size_at_every_speed, and names a 50-lobe torque on a_run_zeroed_off_by_counts_does_not_hide_a_cogging_torque; README, Tests"]
 fn a_many_lobed_torque_beside_a_dry_torque_is_named_whatever_its_fast_windows_read() {
     let off = 3_300_000;
     let mut r = rng(3000 + off);
