@@ -827,11 +827,11 @@ pub(crate) fn one_size_at_every_speed(
         .zip(fast)
         .map(|(&(s, ss), &(f, sf))| (f - s, ss.hypot(sf)))
         .collect();
-    let effect = pendulum_model::effects::by_name(&c.effect)?;
+    let (apart, apart_se) = pendulum_model::effects::by_name(&c.effect)?.estimate(&difference);
     Some(OneSize {
         p: split.p,
-        apart: effect.estimate(&difference).0.abs(),
-        apart_se: effect.estimate(&difference).1,
+        apart: apart.abs(),
+        apart_se,
     })
 }
 
