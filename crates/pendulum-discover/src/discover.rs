@@ -2730,13 +2730,19 @@ impl Views<'_> {
         })
     }
 
-    /// The view of `rows` under `corr` with a shaped candidate's column at its own shape.
-    fn at_shape(&self, corr: &Correction, rows: FitOn, c: &Candidate) -> std::rc::Rc<View> {
+    /// The view of `rows` under `corr`, with a shaped column `(col, value)` set where given
+    /// (a shaped candidate's, at its own shape or its refit's).
+    fn at_shape(
+        &self,
+        corr: &Correction,
+        rows: FitOn,
+        shape: Option<(usize, f64)>,
+    ) -> std::rc::Rc<View> {
         let v = self.get(corr, rows);
-        match c.shaped() {
-            Some(sh) => {
+        match shape {
+            Some((col, value)) => {
                 let mut v = (*v).clone();
-                v.set_shape(sh.col, c.shape);
+                v.set_shape(col, value);
                 std::rc::Rc::new(v)
             }
             None => v,
@@ -2776,7 +2782,7 @@ fn pooled_screen_estimate(
             }
             std::rc::Rc::new(v)
         } else {
-            views.at_shape(corr, rows, c)
+            views.at_shape(corr, rows, c.shaped().map(|sh| (sh.col, c.shape)))
         };
         let f = ols(&v.id_rows, &v.columns_from(cols, from))?;
         let (e, se, _) = to_si(c, &f);
@@ -5192,17 +5198,7 @@ pub fn discover(
         let run_asked =
             accepted && matches!(effect.kind(), Kind::Dynamics | Kind::Mass) && run_at.is_some();
         let (speed_split, run_split) = if speed_asked || run_asked {
-            let on_validate = |shape: Option<(usize, f64)>| {
-                let v = views.get(&correction, FitOn::Validate);
-                match shape {
-                    Some((col, value)) => {
-                        let mut v = (*v).clone();
-                        v.set_shape(col, value);
-                        std::rc::Rc::new(v)
-                    }
-                    None => v,
-                }
-            };
+            let on_validate = |shape| views.at_shape(&correction, FitOn::Validate, shape);
             let both = |f: fn(&[WeakRow], &[usize], &Candidate) -> Option<OneSize>,
                         id: &View,
                         val: &View| {
