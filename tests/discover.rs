@@ -2221,6 +2221,58 @@ fn an_offset_whose_two_sets_of_runs_differ_by_their_zeros_is_named() {
     offset_and_inertia_pair_is_named(400_000);
 }
 
+/// The same pair at `SURVEY_DAMPING=drawn SURVEY_SEED=34` (5.66e-2 rad and 6.96e-3 kg·m²; two
+/// identify runs in chaos, one rotating, two resting): both named, but the offset at 4.45e-2
+/// [2.92e-2, 5.98e-2], the equation error's value on every run, 12 mrad off, while the eight free
+/// decays swung about 5.0e-2 to 7.0e-2 rad (their mean 5.95e-2 ± 0.48e-2). A named offset's value
+/// joins the free decays' centres by precision where the two agree; within 2 mrad.
+#[test]
+fn an_offset_the_equation_error_reads_loosely_is_sized_where_the_free_decays_hang() {
+    offset_and_inertia_pair_is_named(3_400_000);
+}
+
+/// The every-effect survey's lag + tilt pair at `SURVEY_DAMPING=drawn SURVEY_SEED=34` (10.7 ms and
+/// 4.11e-2 rad): both named, the tilt at the screen's 4.72e-2 [4.05e-2, 5.38e-2], 14.7 % high,
+/// while every forced run's accelerometer read 4.113e-2 ± 0.006e-2 as its horizontal axis's slope
+/// on its vertical one. A named tilt joins that reading by precision where the two agree: within
+/// 1 %, and the lag within the score's 0.5 ms.
+#[test]
+fn a_tilt_beside_a_lag_is_sized_by_the_accelerometer_that_reads_it() {
+    let off = 3_400_000;
+    let mut r = rng(3000 + 1 + off);
+    let (t_lag, s_lag, ..) = draw("accel_delay", &mut r);
+    let (t_tilt, s_tilt, ..) = draw("horizontal_base", &mut r);
+    let s = discover(
+        7000 + 1 + off,
+        Base::Reference,
+        0.0,
+        0.5,
+        0.15,
+        &format!("{s_lag}\n{s_tilt}"),
+    );
+    let mut accepted = s.discovery.accepted();
+    accepted.sort_unstable();
+    assert_eq!(
+        accepted,
+        ["accel_delay", "horizontal_base"],
+        "{:#?}",
+        s.discovery.rows
+    );
+    let lag = s.discovery.row("accel_delay").unwrap().estimate;
+    assert!(
+        (lag - t_lag).abs() <= 5e-4,
+        "lag {lag:.4e} against {t_lag:.4e}"
+    );
+    let tilt = s.discovery.row("horizontal_base").unwrap();
+    assert!(
+        (tilt.estimate - t_tilt).abs() <= 0.01 * t_tilt.abs(),
+        "tilt {:.4e} against {t_tilt:.4e}: {}",
+        tilt.estimate,
+        tilt.note
+    );
+    assert!(tilt.note.contains("accelerometer's slope"), "{}", tilt.note);
+}
+
 /// The every-effect survey's pair 4 at `SURVEY_SEED=5` (pairs do not draw their damping): a
 /// 2.97e-2 rad tilted guide beside a 1.02e-2 N·m constant dry torque, on a design whose identify
 /// runs but one rest under the shaker, swinging a few counts to tens at its frequency. The
