@@ -2227,6 +2227,7 @@ fn an_offset_whose_two_sets_of_runs_differ_by_their_zeros_is_named() {
 /// decays swung about 5.0e-2 to 7.0e-2 rad (their mean 5.95e-2 ± 0.48e-2). A named offset's value
 /// joins the free decays' centres by precision where the two agree; within 2 mrad.
 #[test]
+#[ignore = "slow set (a survey pair at SURVEY_DAMPING=drawn SURVEY_SEED=34, 33 s; out of the default suite since the sixty-fourth session, whose default suite took 16:07 on 2 cores alone): the default suite checks the rule on the pendulum-discover unit test a_direct_reading_joins_a_value_by_precision_where_they_agree and names an offset beside an inertia on an_offset_beside_an_inertia_is_not_refused_by_a_view_its_runs_zeros_blind; README, Tests"]
 fn an_offset_the_equation_error_reads_loosely_is_sized_where_the_free_decays_hang() {
     offset_and_inertia_pair_is_named(3_400_000);
 }
@@ -2237,6 +2238,7 @@ fn an_offset_the_equation_error_reads_loosely_is_sized_where_the_free_decays_han
 /// on its vertical one. A named tilt joins that reading by precision where the two agree: within
 /// 1 %, and the lag within the score's 0.5 ms.
 #[test]
+#[ignore = "slow set (a survey pair at SURVEY_DAMPING=drawn SURVEY_SEED=34, 40 s; out of the default suite since the sixty-fourth session, whose default suite took 16:07 on 2 cores alone): the default suite checks the rule on the pendulum-discover unit test a_direct_reading_joins_a_value_by_precision_where_they_agree and reads a tilt from the accelerometer on a_tilt_the_resting_pendulum_hides_from_the_equation_error_is_read_by_the_accelerometer; README, Tests"]
 fn a_tilt_beside_a_lag_is_sized_by_the_accelerometer_that_reads_it() {
     let off = 3_400_000;
     let mut r = rng(3000 + 1 + off);
@@ -3882,49 +3884,16 @@ fn an_offset_the_free_decays_hang_at_is_named_where_the_screen_holds_it_loosely(
 /// is not asked. Both are named, each within 10 %.
 #[test]
 fn a_many_lobed_torque_beside_a_dry_torque_is_named_whatever_its_fast_windows_read() {
-    let off = 3_300_000;
-    let mut r = rng(3000 + off);
-    let (t_dry, s_dry, ..) = draw("coulomb_constant", &mut r);
-    let (t_pos, s_pos, ..) = draw("position_torque", &mut r);
-    assert!(s_pos.contains("k = 31"), "{s_pos}");
-    let s = discover(
-        7000 + off,
-        Base::Reference,
-        0.0,
-        0.5,
-        0.15,
-        &format!("{s_dry}\n{s_pos}"),
-    );
-    let mut accepted = s.discovery.accepted();
-    accepted.sort_unstable();
-    assert_eq!(
-        accepted,
-        ["coulomb_constant", "position_torque"],
-        "{:#?}",
-        s.discovery.rows
-    );
-    for (effect, truth) in [("coulomb_constant", t_dry), ("position_torque", t_pos)] {
-        let est = s.discovery.row(effect).unwrap().estimate;
-        assert!(
-            (est - truth).abs() <= 0.10 * truth,
-            "{effect} {est:.4e} against {truth:.4e}"
-        );
-    }
+    dry_torque_and_position_torque_pair_is_named(3_300_000, 31);
 }
 
-/// The every-effect survey's dry torque + position torque pair at `SURVEY_DAMPING=drawn
-/// SURVEY_SEED=35` (1.02e-2 N·m and a 3.82e-2 N·m torque of k = 35 lobes): both named, the dry
-/// torque first, at 1.148e-2 (+12.7 %), its value on every run's rows without the torque's
-/// columns, while the identify and the validate rows, each asked beside them, read 1.051e-2 and
-/// 1.063e-2. The value on every run is asked with the columns both sets were asked with; both
-/// within 10 %.
-#[test]
-fn a_dry_torque_named_before_a_many_lobed_torque_is_sized_beside_its_columns() {
-    let off = 3_500_000;
+/// The every-effect survey's pair 0 (a constant dry torque beside a position torque) at seed
+/// offset `off`, its torque drawn with `k` lobes: both named and nothing else, each within 10 %.
+fn dry_torque_and_position_torque_pair_is_named(off: u64, k: u32) {
     let mut r = rng(3000 + off);
     let (t_dry, s_dry, ..) = draw("coulomb_constant", &mut r);
     let (t_pos, s_pos, ..) = draw("position_torque", &mut r);
-    assert!(s_pos.contains("k = 35"), "{s_pos}");
+    assert!(s_pos.contains(&format!("k = {k}")), "{s_pos}");
     let s = discover(
         7000 + off,
         Base::Reference,
@@ -3950,6 +3919,18 @@ fn a_dry_torque_named_before_a_many_lobed_torque_is_sized_beside_its_columns() {
             row.note
         );
     }
+}
+
+/// The every-effect survey's dry torque + position torque pair at `SURVEY_DAMPING=drawn
+/// SURVEY_SEED=35` (1.02e-2 N·m and a 3.82e-2 N·m torque of k = 35 lobes): both named, the dry
+/// torque first, at 1.148e-2 (+12.7 %), its value on every run's rows without the torque's
+/// columns, while the identify and the validate rows, each asked beside them, read 1.051e-2 and
+/// 1.063e-2. The value on every run is asked with the columns both sets were asked with; both
+/// within 10 %.
+#[test]
+#[ignore = "slow set (a survey pair at SURVEY_DAMPING=drawn SURVEY_SEED=35, 37 s; out of the default suite since the sixty-fourth session, whose default suite took 16:07 on 2 cores alone): the default suite names the same pair within 10 % at SURVEY_SEED=33 on a_many_lobed_torque_beside_a_dry_torque_is_named_whatever_its_fast_windows_read and the sizes beside the other candidates on the independent pair tests; README, Tests"]
+fn a_dry_torque_named_before_a_many_lobed_torque_is_sized_beside_its_columns() {
+    dry_torque_and_position_torque_pair_is_named(3_500_000, 35);
 }
 
 /// The every-effect survey's offset + inertia pair at `SURVEY_SEED=3` (0.0365 rad and
