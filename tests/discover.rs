@@ -2240,26 +2240,7 @@ fn an_offset_the_equation_error_reads_loosely_is_sized_where_the_free_decays_han
 #[test]
 #[ignore = "slow set (a survey pair at SURVEY_DAMPING=drawn SURVEY_SEED=34, 40 s; out of the default suite since the sixty-fourth session, whose default suite took 16:07 on 2 cores alone): the default suite checks the rule on the pendulum-discover unit test a_direct_reading_joins_a_value_by_precision_where_they_agree and reads a tilt from the accelerometer on a_tilt_the_resting_pendulum_hides_from_the_equation_error_is_read_by_the_accelerometer; README, Tests"]
 fn a_tilt_beside_a_lag_is_sized_by_the_accelerometer_that_reads_it() {
-    let off = 3_400_000;
-    let mut r = rng(3000 + 1 + off);
-    let (t_lag, s_lag, ..) = draw("accel_delay", &mut r);
-    let (t_tilt, s_tilt, ..) = draw("horizontal_base", &mut r);
-    let s = discover(
-        7000 + 1 + off,
-        Base::Reference,
-        0.0,
-        0.5,
-        0.15,
-        &format!("{s_lag}\n{s_tilt}"),
-    );
-    let mut accepted = s.discovery.accepted();
-    accepted.sort_unstable();
-    assert_eq!(
-        accepted,
-        ["accel_delay", "horizontal_base"],
-        "{:#?}",
-        s.discovery.rows
-    );
+    let (s, [t_lag, t_tilt], _) = survey_pair_named(1, 3_400_000, "accel_delay", "horizontal_base");
     let lag = s.discovery.row("accel_delay").unwrap().estimate;
     assert!(
         (lag - t_lag).abs() <= 5e-4,
@@ -2479,31 +2460,41 @@ fn offset_and_inertia_pair_is_named(off: u64) {
 /// The every-effect survey's pair 2 at seed offset `off`: both named and nothing else, the
 /// inertia within 10 %; the summary and the offset's truth.
 fn offset_and_inertia_pair(off: u64) -> (DiscoverSummary, f64) {
-    let mut r = rng(3000 + 2 + off);
-    let (t_off, s_off, ..) = draw("encoder_offset", &mut r);
-    let (t_j, s_j, ..) = draw("extra_inertia", &mut r);
-    let s = discover(
-        7000 + 2 + off,
-        Base::Reference,
-        0.0,
-        0.5,
-        0.15,
-        &format!("{s_off}\n{s_j}"),
-    );
-    let mut accepted = s.discovery.accepted();
-    accepted.sort_unstable();
-    assert_eq!(
-        accepted,
-        ["encoder_offset", "extra_inertia"],
-        "{:#?}",
-        s.discovery.rows
-    );
+    let (s, [t_off, t_j], _) = survey_pair_named(2, off, "encoder_offset", "extra_inertia");
     let j = s.discovery.row("extra_inertia").unwrap().estimate;
     assert!(
         (j - t_j).abs() <= 0.10 * t_j,
         "inertia {j:.4e} against {t_j:.4e}"
     );
     (s, t_off)
+}
+
+/// The every-effect survey's pair `p_idx` (`e1` beside `e2`, drawn as the survey draws them) at
+/// seed offset `off`: both named and nothing else. The summary, the two truths and the two
+/// effects' specs as hidden.
+fn survey_pair_named(
+    p_idx: u64,
+    off: u64,
+    e1: &str,
+    e2: &str,
+) -> (DiscoverSummary, [f64; 2], [String; 2]) {
+    let mut r = rng(3000 + p_idx + off);
+    let (t1, s1, ..) = draw(e1, &mut r);
+    let (t2, s2, ..) = draw(e2, &mut r);
+    let s = discover(
+        7000 + p_idx + off,
+        Base::Reference,
+        0.0,
+        0.5,
+        0.15,
+        &format!("{s1}\n{s2}"),
+    );
+    let mut accepted = s.discovery.accepted();
+    accepted.sort_unstable();
+    let mut want = vec![e1, e2];
+    want.sort_unstable();
+    assert_eq!(accepted, want, "{:#?}", s.discovery.rows);
+    (s, [t1, t2], [s1, s2])
 }
 
 /// A 6.31e-3 N·m breakaway fading at 0.245 rad/s on a drawn design whose identify runs all rest
@@ -3890,26 +3881,9 @@ fn a_many_lobed_torque_beside_a_dry_torque_is_named_whatever_its_fast_windows_re
 /// The every-effect survey's pair 0 (a constant dry torque beside a position torque) at seed
 /// offset `off`, its torque drawn with `k` lobes: both named and nothing else, each within 10 %.
 fn dry_torque_and_position_torque_pair_is_named(off: u64, k: u32) {
-    let mut r = rng(3000 + off);
-    let (t_dry, s_dry, ..) = draw("coulomb_constant", &mut r);
-    let (t_pos, s_pos, ..) = draw("position_torque", &mut r);
+    let (s, [t_dry, t_pos], [_, s_pos]) =
+        survey_pair_named(0, off, "coulomb_constant", "position_torque");
     assert!(s_pos.contains(&format!("k = {k}")), "{s_pos}");
-    let s = discover(
-        7000 + off,
-        Base::Reference,
-        0.0,
-        0.5,
-        0.15,
-        &format!("{s_dry}\n{s_pos}"),
-    );
-    let mut accepted = s.discovery.accepted();
-    accepted.sort_unstable();
-    assert_eq!(
-        accepted,
-        ["coulomb_constant", "position_torque"],
-        "{:#?}",
-        s.discovery.rows
-    );
     for (effect, truth) in [("coulomb_constant", t_dry), ("position_torque", t_pos)] {
         let row = s.discovery.row(effect).unwrap();
         assert!(
