@@ -569,6 +569,7 @@ fn a_dry_torque_refitted_to_nothing_is_not_named_on_the_second_look() {
 /// equation-error fall (7.1 % against 5.4 %), the refit "agreeing" within the interval's upper
 /// side's width. The refit must fall inside the interval on its own side.
 #[test]
+#[ignore = "slow set (campaign 9 of the false-alarm survey at SURVEY_DAMPING=drawn SURVEY_SEED=7, 23 s): the default suite names nothing with nothing hidden on nothing_hidden_from_the_reference_base_on_a_mostly_resting_design_names_nothing and independent::issue_12_independent_i00_none, i01 and i11, and finds a generator on issue_15_finds_the_generator_when_hidden; README, Tests"]
 fn a_generator_refitted_to_nothing_below_its_screens_interval_is_not_named() {
     let off = 700_000;
     let (mut r, mut drag) = (rng(40 + off), rng(9040 + off));
@@ -952,6 +953,7 @@ fn a_breakaway_the_screen_puts_at_the_wrong_speed_is_refitted_at_the_one_the_tra
 /// refused because the runs' own damping factors still disagreed with it in, and nothing was
 /// named. Both are named as a pair, each at its value beside the other.
 #[test]
+#[ignore = "slow set (one drawn design, 35 s): the default suite names both missing terms of the linear base on independent::issue_12_independent_i01_with_the_linear_base_names_the_drag_and_the_bearing_friction; README, Tests"]
 fn a_base_missing_two_terms_names_both_where_each_alone_is_a_partial_explanation() {
     base_missing_drag_and_bearing_names_both(1_606_201);
 }
@@ -1972,6 +1974,7 @@ fn a_run_zeroed_off_by_counts_does_not_hide_a_cogging_torque() {
 /// was named there, −83 %, on 0f9516a. A refit set by a bound confirms nothing, its shape's bound
 /// as much as its size's: named within 10 % or not at all, and then saying why.
 #[test]
+#[ignore = "slow set (a survey draw: `stribeck` k=3 at SURVEY_SEED=6, 22 s): the default suite refuses a refit set by its bound on an_encoder_under_its_header_is_not_named_an_inertia_the_refit_cannot_reach and a breakaway that is a constant dry torque on a_breakaway_no_better_than_the_refused_constant_torque_it_becomes_is_not_named; README, Tests"]
 fn a_breakaway_whose_refit_runs_its_speed_scale_to_the_range_end_is_not_named_there() {
     let (truth, spec, base, a, b, mu) = draw_scaled("stribeck", &mut rng(602_203), 1.0, None);
     let s = discover(606_203, base, a, b, mu, &spec);
@@ -2091,6 +2094,7 @@ fn a_breakaway_shape_is_chosen_again_once_each_runs_zeroing_error_is_held() {
 /// validate runs' E_θ falling 57 % with it). With each set's zeros free, named within 10 %, its
 /// validate runs' own size beside the identify runs'.
 #[test]
+#[ignore = "slow set (a survey draw: `position_torque` k=0 at SURVEY_SEED=0, 23 s): the default suite frees each run's zeros on a_run_zeroed_off_by_counts_does_not_hide_a_cogging_torque and unit test two_sets_of_runs_read_an_offset_apart_by_their_zeros_mean; README, Tests"]
 fn a_torque_is_sized_on_the_validate_runs_with_their_own_encoder_zeros_free() {
     let (_, s) = found_as_surveyed("position_torque", 1500, 5500);
     let row = s.discovery.row("position_torque").unwrap();
@@ -2105,6 +2109,7 @@ fn a_torque_is_sized_on_the_validate_runs_with_their_own_encoder_zeros_free() {
 /// never judged. A candidate that does not free the base it was screened against is held back
 /// while the round's others are judged: the offset is named within 2 mrad, and the torque not.
 #[test]
+#[ignore = "slow set (a survey draw: `encoder_offset` k=1 at SURVEY_DAMPING=drawn SURVEY_SEED=1, 25 s): the default suite names offsets on independent::issue_12_independent_i06_encoder_offset and refuses a refit set by its bound on an_encoder_under_its_header_is_not_named_an_inertia_the_refit_cannot_reach; README, Tests"]
 fn an_offset_is_not_named_a_torque_that_leaves_the_base_pinned() {
     let (truth, s) = run_as_surveyed_with_damping("encoder_offset", 101_801, 109_801, 105_801);
     assert_found(&s, "encoder_offset", truth, 0.0, 0.002);
@@ -2175,6 +2180,7 @@ fn a_lag_is_not_refused_by_a_value_its_resting_validate_runs_never_settle_on() {
 /// step per sample (1.1e-5 rad here; reading an angle as whole counts errs by a quarter step on
 /// average) is one the encoder cannot see. Named within the score's 0.5 ms.
 #[test]
+#[ignore = "slow set (a survey draw: `accel_delay` k=3 at SURVEY_DAMPING=drawn SURVEY_SEED=6, 24 s): the default suite names lags on resting validate runs on a_lag_the_validate_runs_e_theta_cannot_see_is_judged_on_their_equation_error and a_lag_is_not_refused_by_a_value_its_resting_validate_runs_never_settle_on; README, Tests"]
 fn a_lag_whose_trade_moves_resting_runs_by_a_fraction_of_a_count_is_named() {
     let (truth, s) = run_as_surveyed_with_damping("accel_delay", 601_903, 609_903, 605_903);
     assert_lag_named_on_its_equation_error(&s, truth, 5e-4, "one the encoder cannot see");
@@ -2205,6 +2211,7 @@ fn a_lag_the_trajectories_measure_is_confirmed_by_the_held_out_equation_error_on
 /// was counted without each validate run's own zero refit, which takes the offset's column
 /// whole. Both named, the offset within 2 mrad and the inertia within 10 %.
 #[test]
+#[ignore = "slow set (a survey draw: pair 2 at SURVEY_SEED=1, 29 s): the default suite checks each run's zero refit on unit tests what_each_runs_zero_refit_takes_is_out_of_reach and two_sets_of_runs_read_an_offset_apart_by_their_zeros_mean, and names pairs on independent::issue_12_independent_i10_pair; README, Tests"]
 fn an_offset_beside_an_inertia_is_not_refused_by_a_view_its_runs_zeros_blind() {
     offset_and_inertia_pair_is_named(100_000);
 }
@@ -2579,6 +2586,7 @@ fn a_breakaway_whose_two_views_overlap_at_the_trajectories_shape_is_named() {
 /// to hold the value, above 0. (Its size, +21.8 % on every run, misses the 10 %: at the truth's
 /// own v_s the equation error and the trajectories put T_s at about +18 % and +16 %; README.)
 #[test]
+#[ignore = "slow set (a survey draw: `stribeck` k=4 at SURVEY_DAMPING=drawn SURVEY_SEED=8, 29 s): the default suite checks a named breakaway's interval above 0 on a_breakaway_whose_trajectories_range_leaves_out_zero_reads_it_as_its_interval; README, Tests"]
 fn a_breakaway_named_where_its_trajectories_reach_zero_reads_an_interval_above_zero() {
     let (truth, s) = run_as_surveyed_with_damping("stribeck", 802_204, 810_204, 806_204);
     let row = named_alone(&s, "stribeck");
@@ -2631,6 +2639,7 @@ fn a_candidate_the_rows_cannot_fit_does_not_end_the_search() {
 /// ([−0.21, 0.045] N·m: the screen's at its profile's shape, which does not see the breakaway,
 /// widened to hold the refit) still holds 0, so this does not ask what `assert_found` asks of it.
 #[test]
+#[ignore = "slow set (a survey draw: `stribeck` k=1 at SURVEY_SEED=7, 45 s): the default suite judges on the validate runs' free segments on a_loss_the_free_segments_measure_where_the_forced_windows_cannot_is_named and unit test the_held_out_runs_are_the_validate_runs_and_their_moving_free_segments, and names breakaways on a_named_breakaway_is_sized_on_every_runs_trajectories; README, Tests"]
 fn a_breakaway_is_judged_on_the_validate_runs_free_segments_too() {
     let (truth, spec, base, a, b, mu) = draw_scaled("stribeck", &mut rng(702_201), 1.0, None);
     let s = discover(706_201, base, a, b, mu, &spec);
@@ -3708,6 +3717,7 @@ fn a_breakaway_no_better_than_the_refused_constant_torque_it_becomes_is_not_name
 /// clear, fell 3.1 %, and the breakaway was not named. A view that cannot see the effect neither
 /// confirms nor refuses it: named alone, within 10 %.
 #[test]
+#[ignore = "slow set (a survey draw: `stribeck` k=4 at SURVEY_DAMPING=drawn SURVEY_SEED=3, 39 s): the default suite names breakaways on a_named_breakaway_is_sized_on_every_runs_trajectories and a_breakaway_whose_two_views_overlap_at_the_trajectories_shape_is_named, and judges a view that cannot see an effect on a_lag_the_validate_runs_e_theta_cannot_see_is_judged_on_their_equation_error; README, Tests"]
 fn a_breakaway_the_held_out_equation_error_cannot_see_is_named_on_its_trajectories() {
     let off = 300_000;
     let (truth, spec, base, a, b, mu) = draw_scaled(

@@ -894,6 +894,7 @@ fn a_run_to_run_friction_is_not_named_a_breakaway_that_is_a_constant_dry_torque(
 /// (noise 5.7 %) and a spring in the unwrapped θ took 89 % off it. Freeing the base stands in
 /// for that view's confirmation, not against it: nothing named, the words speak of θ.
 #[test]
+#[ignore = "slow set (the departure survey's draw 0 at DEPARTURE_SEED=3, 49 s on 2 cores): the default suite checks a cable's rest not named an offset on a_cable_whose_rest_an_offset_takes_up_is_not_named_one_beside_the_spring_left; README, Tests"]
 fn a_cable_anchored_off_the_vertical_is_not_named_an_encoder_offset() {
     let words = named_nothing_and_said("anchored_cable", 0, 300_000);
     assert!(words.contains("θ (unwrapped)"), "{words}");
@@ -1006,6 +1007,7 @@ fn a_friction_that_differs_from_run_to_run_is_not_named_a_generator_at_zero_dead
 /// was exempt from that view's contradiction. Nothing named, and the words say the error
 /// follows θ (mod 2π).
 #[test]
+#[ignore = "slow set (the departure survey's draw 0 at DEPARTURE_SEED=4, 28 s): the default suite checks a code disc named nothing on an_off_centre_code_disc_is_not_named_a_position_torque_on_the_equation_error_alone; README, Tests"]
 fn an_off_centre_code_disc_is_not_named_an_encoder_offset() {
     let words = named_nothing_and_said("encoder_eccentricity", 0, 400_000);
     assert!(words.contains("θ (mod 2π)"), "{words}");
@@ -1019,6 +1021,7 @@ fn an_off_centre_code_disc_is_not_named_an_encoder_offset() {
 /// their E_θ fell 8.0 % ± 10.2 %. An inertia one view puts within the tolerance is not named;
 /// the remaining error is reported.
 #[test]
+#[ignore = "slow set (the departure survey's draw 3 at DEPARTURE_SEED=6, 24 s): the default suite checks a code disc named nothing on an_off_centre_code_disc_is_not_named_a_position_torque_on_the_equation_error_alone; README, Tests"]
 fn an_off_centre_code_disc_is_not_named_an_inertia_its_trajectories_put_within_the_tolerance() {
     named_nothing_and_said("encoder_eccentricity", 3, 600_000);
 }
