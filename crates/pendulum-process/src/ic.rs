@@ -148,12 +148,18 @@ pub fn hanging_position(run: &RunData, t_from: f64, t_to: f64) -> Option<f64> {
     if clean.len() < 3 {
         return None;
     }
+    // Rows of Pascal's triangle, k = 2, 3, 4.
+    const BINOMIAL: [&[f64]; 3] = [
+        &[1.0, 2.0, 1.0],
+        &[1.0, 3.0, 3.0, 1.0],
+        &[1.0, 4.0, 6.0, 4.0, 1.0],
+    ];
     let k = (clean.len() - 1).min(4);
-    let weights: Vec<f64> = (0..=k).map(|j| binomial(k, j)).collect();
+    let weights = BINOMIAL[k - 2];
     let total = weights.iter().sum::<f64>();
     let mut centres: Vec<f64> = clean
         .windows(k + 1)
-        .map(|w| w.iter().zip(&weights).map(|(e, c)| e * c).sum::<f64>() / total)
+        .map(|w| w.iter().zip(weights).map(|(e, c)| e * c).sum::<f64>() / total)
         .collect();
     centres.sort_by(f64::total_cmp);
     Some(centres[centres.len() / 2])
@@ -181,8 +187,4 @@ fn alternating_extrema(ext: &[f64], min_swing_rad: f64) -> Vec<f64> {
         clean.push(e);
     }
     clean
-}
-
-fn binomial(n: usize, k: usize) -> f64 {
-    (0..k).fold(1.0, |acc, j| acc * (n - j) as f64 / (j + 1) as f64)
 }
