@@ -486,7 +486,7 @@ fn regression_issue_16_identify_reaches_one_decay_law() {
 /// wide hand starts (1.0 to 2.4 rad) under a quadratic drag, with dry and viscous friction
 /// beside it, on the
 /// rig's 4096-count encoder: within half a count (0.77 mrad) of the simulated zero error (the
-/// worst of the twelve 0.47 mrad). The amplitude there shrinks fast and then slowly (not
+/// worst of the twelve 0.14 mrad). The amplitude there shrinks fast and then slowly (not
 /// linearly), and the three-point mean of successive extrema read eleven of these twelve centres
 /// 1.0 to 1.8 mrad off.
 #[test]

@@ -109,7 +109,8 @@ pub fn estimate_state(
 /// hand start shrinks it fast and then slowly, and the three-point mean (k = 2) left a quarter of
 /// its second difference: on the eight free decays of a drawn campaign (the every-effect survey's
 /// `encoder_offset` k=2, `SURVEY_SEED=15`) 0.9 to 5.8 mrad off each run's true zero, where k = 4
-/// leaves 0.06 to 0.54 (1.9 on a 0.14 rad decay that dry friction stops in four swings);
+/// on the turning points below leaves at most 0.39 (at `SURVEY_SEED=36`, k=0: at most 0.64, and
+/// 1.3 and 1.8 on two short decays of three and five turning points);
 /// `a_wide_decay_s_centre_is_read_within_a_fraction_of_a_count`. The binomial weights also
 /// average the extrema's noise better as k grows (Σ C(k, j)² / 4^k: 0.375, 0.31, 0.27). `None`
 /// when there are fewer than three swings or the pendulum turns over.
@@ -124,28 +125,15 @@ pub fn hanging_position(run: &RunData, t_from: f64, t_to: f64) -> Option<f64> {
     if seg.iter().any(|x| x.abs() > std::f64::consts::PI) {
         return None;
     }
-    // Smooth over ±5 samples so that quantisation steps do not make false extrema.
-    let w = 5;
-    let sm: Vec<f64> = (0..seg.len())
-        .map(|i| {
-            let a = i.saturating_sub(w);
-            let b = (i + w + 1).min(seg.len());
-            seg[a..b].iter().sum::<f64>() / (b - a) as f64
-        })
+    // The turning points the free decay's envelope and alignment read (hysteresis on the
+    // angle's noise, so encoder steps and a creeping stop make none; each refined by a parabola),
+    // from the first real swing (a hand's tremor before the release is none).
+    let tps = pendulum_explain::turning_points(&t[lo..hi], seg);
+    let extrema: Vec<f64> = tps[pendulum_explain::first_swing(&tps)..]
+        .iter()
+        .map(|p| p.theta_rad)
         .collect();
-    let mut ext = Vec::new();
-    let mut last_dir = 0i8;
-    for i in 1..sm.len() {
-        let d = (sm[i] - sm[i - 1]).signum() as i8;
-        if d != 0 {
-            if last_dir != 0 && d != last_dir {
-                ext.push(sm[i - 1]);
-            }
-            last_dir = d;
-        }
-    }
-    let clean = alternating_extrema(&ext, 4.0 * 2.0 * std::f64::consts::PI / 4096.0);
-    if clean.len() < 3 {
+    if extrema.len() < 3 {
         return None;
     }
     // Rows of Pascal's triangle, k = 2, 3, 4.
@@ -154,37 +142,13 @@ pub fn hanging_position(run: &RunData, t_from: f64, t_to: f64) -> Option<f64> {
         &[1.0, 3.0, 3.0, 1.0],
         &[1.0, 4.0, 6.0, 4.0, 1.0],
     ];
-    let k = (clean.len() - 1).min(4);
+    let k = (extrema.len() - 1).min(4);
     let weights = BINOMIAL[k - 2];
     let total = weights.iter().sum::<f64>();
-    let mut centres: Vec<f64> = clean
+    let mut centres: Vec<f64> = extrema
         .windows(k + 1)
         .map(|w| w.iter().zip(weights).map(|(e, c)| e * c).sum::<f64>() / total)
         .collect();
     centres.sort_by(f64::total_cmp);
     Some(centres[centres.len() / 2])
-}
-
-/// Turning points that alternate, with a real swing (at least `min_swing_rad`) between them.
-/// A turning point within `min_swing_rad` of the last kept is a wobble and is dropped; one that
-/// carries on in the direction of the last swing (the pendulum creeping a few counts at a time as
-/// dry friction stops it) replaces the last kept, which was not a turning point after all. Kept,
-/// such a run of same-direction steps read as a swing and put 7 mrad into a small decay's centre.
-fn alternating_extrema(ext: &[f64], min_swing_rad: f64) -> Vec<f64> {
-    let mut clean: Vec<f64> = Vec::new();
-    for &e in ext {
-        if let Some(&last) = clean.last() {
-            if (e - last).abs() < min_swing_rad {
-                continue;
-            }
-            if let [.., before, last] = clean[..] {
-                if (e - last).signum() == (last - before).signum() {
-                    *clean.last_mut().expect("two kept") = e;
-                    continue;
-                }
-            }
-        }
-        clean.push(e);
-    }
-    clean
 }
