@@ -2128,16 +2128,17 @@ fn an_offset_is_not_named_a_torque_that_leaves_the_base_pinned() {
 /// there either. Since 71d5b00 a named offset joins the free decays' centres by precision; here
 /// their mean, −3.698e-2 ± 0.280e-2 over eight runs, sits 4.7 mrad short of the truth (on a base
 /// pinned at μ's bound, as seed 36's `encoder_offset` k=0, whose centres read −4.59e-2 for
-/// −4.78e-2), and the join pulls every run's −4.0024e-2 to −3.7208e-2: a known failure. Part of
+/// −4.78e-2), and the join pulls every run's −4.0024e-2 to −3.7208e-2: a known failure. Most of
 /// it was the centres' own estimator (the three-point mean of successive extrema left a quarter
 /// of the amplitudes' second difference: 0.9 to 5.8 mrad off each run's true zero here). Read with
-/// five-point binomial weights the centres are −3.9395e-2 ± 0.085e-2, within 0.34 mrad of the
-/// runs' true zeros' mean, −3.974e-2: the twin zeroes each run up to 2 counts off the hanging
-/// position (rig.md: "to within a few counts"), and these eight drew +1.25 counts on average
-/// (1.9 mrad; the mean of eight such draws has a spread of 0.77 mrad). Named at −3.9400e-2,
-/// 2.25 mrad off the effect's size: still outside the score's 2 mrad, by the draw.
+/// five-point binomial weights on the envelope's turning points the centres are −3.9623e-2 ±
+/// 0.072e-2, within 0.12 mrad of the runs' true zeros' mean, −3.974e-2: the twin zeroes each run
+/// up to 2 counts off the hanging position (rig.md: "to within a few counts"), and these eight
+/// drew +1.25 counts on average (1.9 mrad; the mean of eight such draws has a spread of 0.77
+/// mrad). Named at −3.9625e-2, 2.03 mrad off the effect's size: just outside the score's 2 mrad,
+/// by the draw.
 #[test]
-#[ignore = "known failure (issue 12) since 71d5b00 (found by the slow set in the sixty-fifth session; it passes on 0023546): every run's value, −4.0024e-2 rad, is joined with the eight free decays' centres, −3.9395e-2 ± 0.085e-2 (within 0.34 mrad of the runs' true zeros' mean −3.974e-2: the twin's per-run zero draws average +1.25 counts here), and named at −3.9400e-2, 2.25 mrad off the effect's −4.1655e-2; the default suite names an offset end to end on independent::issue_12_independent_i06_encoder_offset; README, Tests"]
+#[ignore = "known failure (issue 12) since 71d5b00 (found by the slow set in the sixty-fifth session; it passes on 0023546): every run's value, −4.0024e-2 rad, is joined with the eight free decays' centres, −3.9623e-2 ± 0.072e-2 (within 0.12 mrad of the runs' true zeros' mean −3.974e-2: the twin's per-run zero draws average +1.25 counts here), and named at −3.9625e-2, 2.03 mrad off the effect's −4.1655e-2; the default suite names an offset end to end on independent::issue_12_independent_i06_encoder_offset; README, Tests"]
 fn an_offset_whose_validate_equation_error_does_not_move_is_not_refused_by_it() {
     let (truth, s) =
         run_as_surveyed_with_damping("encoder_offset", 1_501_802, 1_509_802, 1_505_802);
