@@ -2151,6 +2151,57 @@ fn an_offset_whose_validate_equation_error_does_not_move_is_not_refused_by_it() 
     );
 }
 
+/// Where each run's free decay hangs (`pendulum_process::ic::hanging_position`: the offset's
+/// free-decay view and a torque's rest angles rest on it), on twin campaigns drawn as the
+/// every-effect survey draws an `encoder_offset` (per run: bob, length, crank, speed, format,
+/// hand start, durations; the damping drawn too), against each run's true zero: the offset plus
+/// that run's own zeroing error (a few counts, `truth.json`). Over every run that gives a
+/// reading, the mean error within a third of a count and none beyond 2 mrad (the score's bar for
+/// an offset): 76 runs read, mean 0.07 mrad, worst 0.50. Read as the three-point mean of a
+/// cruder extrema finder's extrema (before 5b22890) the same runs gave a mean of 1.99 mrad and a
+/// worst of 7.06; its five-point mean (5b22890) 0.14 and 1.20.
+#[test]
+fn each_runs_free_decay_is_read_at_its_own_zero_on_drawn_designs() {
+    let q_rad = std::f64::consts::TAU / 4096.0;
+    let mut errs = Vec::new();
+    for i in 0..10u64 {
+        let (offset, spec, _, a, b, mu) = draw_scaled(
+            "encoder_offset",
+            &mut rng(7_100_000 + i),
+            1.0,
+            Some(&mut rng(7_200_000 + i)),
+        );
+        let dir = tempfile::tempdir().unwrap();
+        let truth = make_campaign(dir.path(), &campaign(7_300_000 + i, a, b, mu, &spec));
+        let runs = pendulum_jobs::runs::load_runs(dir.path()).unwrap();
+        for run in &runs {
+            let Ok(al) = pendulum_process::align(run, &pendulum_process::AlignConfig::default())
+            else {
+                continue;
+            };
+            let (t0, t1) = al.free_segment_s;
+            let Some(h) = pendulum_process::ic::hanging_position(run, t0, t1) else {
+                continue;
+            };
+            let rt = truth.runs.iter().find(|r| r.id == run.id).unwrap();
+            let zero = offset + rt.encoder_zero_counts as f64 * q_rad;
+            eprintln!("campaign {i} run {}: centre {h:+.5} for {zero:+.5}", run.id);
+            errs.push(h - zero);
+        }
+    }
+    let mean_abs = errs.iter().map(|e| e.abs()).sum::<f64>() / errs.len() as f64;
+    let worst = errs.iter().fold(0.0_f64, |m, e| m.max(e.abs()));
+    eprintln!(
+        "{} runs read: mean |error| {:.3} mrad, worst {:.3} mrad",
+        errs.len(),
+        mean_abs * 1e3,
+        worst * 1e3
+    );
+    assert!(errs.len() >= 40, "only {} runs read", errs.len());
+    assert!(mean_abs < q_rad / 3.0, "mean |error| {mean_abs:.2e}");
+    assert!(worst < 2e-3, "worst {worst:.2e}");
+}
+
 /// A 4.91 ms accelerometer lag on a drawn design (the every-effect survey's `accel_delay` k=1
 /// with the damping drawn, `SURVEY_SEED=2`) whose one oscillating identify run, forced near its
 /// natural frequency, was zeroed 2 counts off: with that run's zero left as measured, the lag's
