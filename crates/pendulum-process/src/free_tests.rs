@@ -370,6 +370,15 @@ fn regression_issue_13_a_hold_near_upright_is_no_swing() {
         "t0 = {} s: the hold's tremor was taken for a swing",
         al.t0_s
     );
+    // Nor is it a swing to the free decay's centre (read from the same turning points): the
+    // pendulum hangs at 0 here, read within half a count of a 40000-count encoder (−7.7e-7 rad;
+    // the three-point mean of a ±5-sample box's extrema, before 5b22890, read 2.1e-4).
+    let hang = crate::ic::hanging_position(&run, 0.0, 20.0).expect("swings to read");
+    eprintln!("centre {hang:.3e} rad");
+    assert!(
+        hang.abs() < 0.5 * std::f64::consts::TAU / 40000.0,
+        "centre {hang}"
+    );
 }
 
 /// Issue 16 item 1: one decay law in `identify`. A viscous + bearing-friction decay is fitted
