@@ -4874,7 +4874,11 @@ pub fn discover(
                 )
                 .is_some_and(|d| {
                     d.variable == pendulum_model::Variable::Angle
-                        && d.heldout_gain > cfg.eq_gain_min.max(d.heldout_noise)
+                        && d.heldout_gain
+                            > fall_by_factor(
+                                cfg.eq_gain_min.max(d.heldout_noise),
+                                SECOND_LOOK_GAIN_FACTOR,
+                            )
                 });
         // Everything but the agreement of the views (the pair look asks for that apart).
         let plausible_but_agree =
