@@ -1225,7 +1225,19 @@ fn sensor_heldout(val: &[f64], nominal: f64, fitted: f64) -> (f64, f64, f64) {
 /// two agree ([`sizes_disagree`] says not): the joined value and its interval. None where they
 /// disagree (one of the views holds something the other does not: the value stays as it was)
 /// or where either interval is not finite and positive.
-fn joined_with_reading(value: (f64, f64, f64), reading: (f64, f64)) -> Option<(f64, f64, f64)> {
+///
+/// `shared`: the reading's scatter is an error the value shares, not one of its own. The free
+/// decays' centres read each run's zero, the offset plus that run's zeroing error (a few counts),
+/// and the equation error's offset column is those zeros' mean too (each run's zero contrast
+/// free): both views read one mean, whose distance from the offset is the zeroing draws' and
+/// only the centres' scatter measures. Joined as independent, the interval shrank below that:
+/// drawn seed 7's offset joined to ±1.02 mrad while its centres' own interval was ±1.18. So the
+/// joined interval is then no narrower than the reading's own.
+fn joined_with_reading(
+    value: (f64, f64, f64),
+    reading: (f64, f64),
+    shared: bool,
+) -> Option<(f64, f64, f64)> {
     let (v, lo, hi) = value;
     let (r, r_half) = reading;
     let v_half = 0.5 * (hi - lo);
@@ -1239,6 +1251,7 @@ fn joined_with_reading(value: (f64, f64, f64), reading: (f64, f64)) -> Option<(f
     let (wv, wr) = (v_half.powi(-2), r_half.powi(-2));
     let joined = (wv * v + wr * r) / (wv + wr);
     let half = (wv + wr).sqrt().recip();
+    let half = if shared { half.max(r_half) } else { half };
     Some((joined, joined - half, joined + half))
 }
 
@@ -5782,6 +5795,8 @@ pub fn discover(
         // its horizontal axis on its vertical one ([`tilt_reading`]). A hidden 4.11e-2 rad tilt
         // beside a 10.7 ms lag (the same survey's pair 1) was screened at 4.72e-2 [4.05e-2,
         // 5.38e-2], 14.7 % high.
+        // (The centres' scatter is the runs' zeroing error, which the equation error's value
+        // shares: `joined_with_reading`'s `shared`.)
         let reading: Option<(f64, f64, usize, &str)> = if !accepted {
             None
         } else if effect.reads_hanging_position() {
@@ -5802,8 +5817,12 @@ pub fn discover(
             None
         };
         let read_directly = reading.and_then(|(mean, half, n, what)| {
-            joined_with_reading((value, ci_low, ci_high), (mean, half))
-                .map(|joined| (joined, mean, half, n, what))
+            joined_with_reading(
+                (value, ci_low, ci_high),
+                (mean, half),
+                effect.reads_hanging_position(),
+            )
+            .map(|joined| (joined, mean, half, n, what))
         });
         let (value, ci_low, ci_high) = read_directly.map_or((value, ci_low, ci_high), |j| j.0);
         let row = DiagnosisRow {
@@ -6937,18 +6956,43 @@ mod tests {
     /// rad and eight free decays' centres 5.95e-2 ± 0.46e-2.)
     #[test]
     fn a_direct_reading_joins_a_value_by_precision_where_they_agree() {
-        let (v, lo, hi) = joined_with_reading((4.45e-2, 2.92e-2, 5.98e-2), (5.95e-2, 0.46e-2))
-            .expect("they agree");
+        let (v, lo, hi) =
+            joined_with_reading((4.45e-2, 2.92e-2, 5.98e-2), (5.95e-2, 0.46e-2), false)
+                .expect("they agree");
         assert!(v > 5.7e-2 && v < 5.95e-2, "{v}");
         assert!(hi - lo < 2.0 * 0.46e-2 && lo < v && v < hi);
         // Equal precision: the midpoint.
-        let (m, ..) = joined_with_reading((1.0, 0.9, 1.1), (1.05, 0.1)).unwrap();
+        let (m, ..) = joined_with_reading((1.0, 0.9, 1.1), (1.05, 0.1), false).unwrap();
         assert!((m - 1.025).abs() < 1e-12);
         // Apart beyond both intervals and 10 %: no join.
-        assert!(joined_with_reading((4.45e-2, 4.3e-2, 4.6e-2), (5.95e-2, 0.46e-2)).is_none());
+        assert!(
+            joined_with_reading((4.45e-2, 4.3e-2, 4.6e-2), (5.95e-2, 0.46e-2), false).is_none()
+        );
         // No interval to weigh: no join.
-        assert!(joined_with_reading((4.45e-2, f64::NAN, 5.0e-2), (5.95e-2, 0.46e-2)).is_none());
-        assert!(joined_with_reading((4.45e-2, 4.0e-2, 5.0e-2), (5.95e-2, 0.0)).is_none());
+        assert!(
+            joined_with_reading((4.45e-2, f64::NAN, 5.0e-2), (5.95e-2, 0.46e-2), false).is_none()
+        );
+        assert!(joined_with_reading((4.45e-2, 4.0e-2, 5.0e-2), (5.95e-2, 0.0), false).is_none());
+    }
+
+    /// A reading whose scatter the value shares (the free decays' centres and the equation
+    /// error both read the runs' zeros' mean): the joined value is still weighed by precision,
+    /// but its interval is no narrower than the reading's own, which alone measures how far
+    /// that mean may sit from the offset. (Drawn seed 7's offset: every run's equation error
+    /// about ±2.0 mrad, the centres ±1.18, joined as independent to ±1.02.)
+    #[test]
+    fn a_reading_whose_scatter_the_value_shares_keeps_its_own_interval() {
+        let value = (3.80e-2, 3.60e-2, 4.00e-2);
+        let reading = (3.84e-2, 0.118e-2);
+        let (vi, loi, hii) = joined_with_reading(value, reading, false).unwrap();
+        let (vs, los, his) = joined_with_reading(value, reading, true).unwrap();
+        // The same value either way: only the interval differs.
+        assert!((vi - vs).abs() < 1e-15);
+        assert!(0.5 * (hii - loi) < 0.99 * 0.118e-2, "{loi} {hii}");
+        assert!((0.5 * (his - los) - 0.118e-2).abs() < 1e-12, "{los} {his}");
+        // A reading far less precise than the value: the joined interval is the reading's width.
+        let (_, lo, hi) = joined_with_reading((1.0, 0.99, 1.01), (1.0, 0.5), true).unwrap();
+        assert!((0.5 * (hi - lo) - 0.5).abs() < 1e-12);
     }
 
     /// A refinement whose steps shrink settles; one whose steps go on moving the value (a
