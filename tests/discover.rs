@@ -2829,13 +2829,14 @@ fn a_lag_the_resting_identify_runs_cannot_estimate_is_not_ruled_out() {
 /// 3.990e-2, 3.842e-2, 3.694e-2, 3.972e-2, 3.685e-2, 3.681e-2, 4.007e-2 for zeros of the offset
 /// plus 1, 2, 1, 0, 2, 0, 0, 2 counts), so the interval is that of these eight zeros' mean,
 /// 3.839e-2: named 3.8341e-2 [3.7318e-2, 3.9364e-2], 1.48 mrad from the offset (within the
-/// score's 2 mrad). The eight drew +1.0 count on average with a scatter of 0.93 counts (the
+/// score's 2 mrad); since b287d7a the interval is the centres' own, [3.7165e-2, 3.9518e-2] (the
+/// equation error's value reads the same zeros: joined as independent, the interval shrank). The eight drew +1.0 count on average with a scatter of 0.93 counts (the
 /// twin draws −2 to +2, 1.41): their mean sits 3.0 of its own standard errors from the offset,
 /// where a 95 % interval of a mean misses about 2 % of draws. Before 5b22890 the centres' own
 /// reading errors (1.99 mrad a run on average, up to 7 on drawn designs:
 /// `each_runs_free_decay_is_read_at_its_own_zero_on_drawn_designs`) widened it to hold the truth.
 #[test]
-#[ignore = "known failure (issue 12) on 0222dce (passed on f3c656f): the free decays' centres read each run's own zero within 0.2 mrad, and these eight zeros' mean, +1.0 count from the offset with a scatter of 0.93 counts, is 3.0 standard errors from it; named 3.8341e-2 [3.7318e-2, 3.9364e-2] for 3.6856e-2 (1.48 mrad, within the score's bar); the default suite checks the rule on the pendulum-discover unit test an_offsets_interval_counts_each_runs_zeroing_error and names an offset end to end on independent::issue_12_independent_i06_encoder_offset; README, Tests"]
+#[ignore = "known failure (issue 12) on 0222dce (passed on f3c656f): the free decays' centres read each run's own zero within 0.2 mrad, and these eight zeros' mean, +1.0 count from the offset with a scatter of 0.93 counts, is 3.0 standard errors from it; named 3.8341e-2 [3.7165e-2, 3.9518e-2] for 3.6856e-2 on b287d7a (the centres' own interval; [3.7318e-2, 3.9364e-2] before it) (1.48 mrad, within the score's bar); the default suite checks the rule on the pendulum-discover unit test an_offsets_interval_counts_each_runs_zeroing_error and names an offset end to end on independent::issue_12_independent_i06_encoder_offset; README, Tests"]
 fn a_named_offsets_interval_counts_each_runs_zeroing_error() {
     let (truth, spec, base, a, b, mu) = draw_scaled("encoder_offset", &mut rng(701_802), 1.0, None);
     let s = discover(705_802, base, a, b, mu, &spec);
