@@ -2169,6 +2169,19 @@ fn an_offset_on_a_pinned_base_is_not_refused_for_a_remainder_a_seventieth_its_si
     assert_found(&s, "encoder_offset", truth, 0.0, 0.002);
 }
 
+/// A 6.61e-3 N·m breakaway fading at 0.384 rad/s on a drawn design (the every-effect survey's
+/// `stribeck` k=4 at `SURVEY_DAMPING=drawn SURVEY_SEED=39`) whose validate runs hardly see it:
+/// refitted at 5.12e-3 on the identify runs, it took 20.7 % ± 10.5 % off their E_θ, short of twice
+/// its bar, and was not named. The identify runs, each left out of the refits that judge it,
+/// join them as held-out runs (`left_out_gain`): 21.3 % ± 7.4 % against the 14.7 % needed, and
+/// it is named at 6.52e-3 (−1.3 %), the note saying on what evidence.
+#[test]
+#[ignore = "slow set (one drawn design, 40 s): the default suite names breakaways on a_breakaway_is_judged_on_the_validate_runs_free_segments_too and a_named_breakaway_is_sized_on_every_runs_trajectories; README, Tests"]
+fn a_breakaway_the_validate_runs_cannot_see_is_judged_on_the_identify_runs_left_out() {
+    let (truth, s) = run_as_surveyed_with_damping("stribeck", 3_902_204, 3_910_204, 3_906_204);
+    assert_found_saying(&s, "stribeck", truth, (0.10, 0.0), "left out one at a time");
+}
+
 /// Where each run's free decay hangs (`pendulum_process::ic::hanging_position`: the offset's
 /// free-decay view and a torque's rest angles rest on it), on twin campaigns drawn as the
 /// every-effect survey draws an `encoder_offset` (per run: bob, length, crank, speed, format,

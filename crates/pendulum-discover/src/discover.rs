@@ -3039,6 +3039,80 @@ fn refit_with(
     (problem.full(&x), f)
 }
 
+/// The run a trajectory or a held-out piece belongs to: its own id, or the id of the run whose
+/// free segment before the shaker starts it is (`<run>-free`).
+fn parent_run(id: &str) -> &str {
+    id.strip_suffix("-free").unwrap_or(id)
+}
+
+/// The identify runs' own held-out view of a candidate the validate runs cannot judge: each
+/// moving identify run (its forced window and its free segment) left out in turn, the current
+/// model and the candidate's refitted on the trajectories of the others (`traj_runs`, `traj_ics`,
+/// from their refits on every run, `current` and `candidate`), and both validated on the run left
+/// out (its pieces in `id_held`, as a validate run is: its own initial state estimated). Those
+/// validations, as `effect`'s judgement sees them ([`judged_for`], `free_moving`: the identify
+/// runs' free segments), are pooled with the validate runs' (`before_val`, `after_val` on
+/// `held_runs`) into one held-out E_θ gain and its noise ([`effect_heldout_gain`]). `None` with
+/// fewer than three moving identify runs (a fit on one run judged on another is no campaign's
+/// fit) or trajectories whose initial states do not pair with them.
+///
+/// A breakaway acts within a few v_s of the turning points; where the validate runs rotate,
+/// rest or tumble, their E_θ cannot see it, while the identify runs that showed it are as good a
+/// held-out view once each is left out of the fit that judges it. Of fifty drawn breakaways
+/// (drawn seeds 35–44), 27 were not named, 11 of those with a refit within 10 % of the truth
+/// refused only for want of held-out evidence (seed 42's `stribeck` k=3: E_θ 2.0 % ± 2.4 % on
+/// validate runs that never come near rest).
+#[allow(clippy::too_many_arguments)]
+fn left_out_gain(
+    effect: &dyn pendulum_model::effects::Effect,
+    traj_runs: &[PreparedRun],
+    traj_ics: &[f64],
+    id_held: &[PreparedRun],
+    free_moving: &[PreparedRun],
+    current: (&ModelSpec, &[f64]),
+    candidate: (&ModelSpec, &[f64]),
+    val: (&[RunFit], &[RunFit], &[PreparedRun]),
+    cfg: &DiscoverConfig,
+) -> Result<Option<(f64, f64)>, ProcessError> {
+    if traj_ics.len() != 2 * traj_runs.len() {
+        return Ok(None);
+    }
+    let mut folds: Vec<&str> = traj_runs.iter().map(|r| parent_run(&r.id)).collect();
+    folds.sort_unstable();
+    folds.dedup();
+    if folds.len() < 3 {
+        return Ok(None);
+    }
+    let (mut before, mut after) = (val.0.to_vec(), val.1.to_vec());
+    let mut held: Vec<PreparedRun> = val.2.to_vec();
+    for out in folds {
+        let keep: Vec<usize> = (0..traj_runs.len())
+            .filter(|&j| parent_run(&traj_runs[j].id) != out)
+            .collect();
+        let runs: Vec<PreparedRun> = keep.iter().map(|&j| traj_runs[j].clone()).collect();
+        let ics: Vec<f64> = keep
+            .iter()
+            .flat_map(|&j| [traj_ics[2 * j], traj_ics[2 * j + 1]])
+            .collect();
+        let left: Vec<PreparedRun> = id_held
+            .iter()
+            .filter(|r| parent_run(&r.id) == out)
+            .cloned()
+            .collect();
+        if left.is_empty() {
+            continue;
+        }
+        let (xb, _) = refit(&runs, current.0, current.1, &ics, cfg.refit_evals);
+        let (xa, _) = refit(&runs, candidate.0, candidate.1, &ics, cfg.refit_evals);
+        let vb = validate(&left, current.0, &xb, &cfg.validate)?;
+        let va = validate(&left, candidate.0, &xa, &cfg.validate)?;
+        before.extend(judged_for(effect, &vb, free_moving));
+        after.extend(judged_for(effect, &va, free_moving));
+        held.extend(left);
+    }
+    Ok(Some(effect_heldout_gain(effect, &before, &after, &held)))
+}
+
 fn e_total(v: &[RunFit]) -> f64 {
     v.iter().map(|r| r.e_theta).sum()
 }
@@ -5053,6 +5127,9 @@ pub fn discover(
             && sensor_heldout(&hanging_val, 0.0, refit_est).0 > SENSOR_HELDOUT_GAIN;
         let agree = agree || hanging_measures;
         let plausible = plausible_but_agree && agree;
+        // The identify runs' left-out view where the second look asked it ([`left_out_gain`]):
+        // its gain, noise and whether it passed.
+        let mut second_look_left_out: Option<(f64, f64, f64, bool)> = None;
         let accepted = if second_look {
             // Both held-out views: the validate runs' E_θ beyond twice the screen route's bar,
             // and their equation error's fall beyond its own (the identify runs' equation error
@@ -5097,14 +5174,54 @@ pub fn discover(
             } else {
                 SECOND_LOOK_GAIN_FACTOR
             };
-            let passes = plausible
+            let others_pass = plausible
                 && (informative || shape_views_agree)
-                && gain > margin * gain_needed
                 && (eq_confirms
                     || shape_views_agree
                     || hanging_measures
                     || (informative && eq_blind_not_against)
                     || (unpins && !eq_rises));
+            // Where the validate runs alone fall short of the bar but do not contradict the
+            // candidate (no rise beyond their noise), the identify runs left out one at a time
+            // join them as held-out runs ([`left_out_gain`]), judged at the same bar. Only for
+            // a breakaway: the one catalogue effect whose trace lives where a campaign's
+            // validate runs may never go (the turning points of a slow swing).
+            // And only where the trajectories tell its size from its absence (their own range,
+            // [`trajectory_range`], leaves out 0, as a named breakaway's interval must): beside
+            // their silence the left-out runs' fall would be the only view that sees it. (Two
+            // drawn breakaways whose trajectories held them within [0, 2.5e-2] and [0, 3.2e-2]
+            // cleared the left-out bar by 1.2 % and 2.1 % and were refitted 26 % and 34 % off.)
+            let left_out = if others_pass
+                && gain <= margin * gain_needed
+                && gain >= -noise
+                && c.shaped().is_some()
+                && effect.sets_sticking_capacity()
+                && size_index.is_some_and(|i| shape_range.unwrap_or_else(|| range_of(i)).0 > 0.0)
+            {
+                let id_held = beside(&id_runs, &free_moving);
+                left_out_gain(
+                    effect,
+                    &traj_runs,
+                    &traj_ics,
+                    &id_held,
+                    &free_moving,
+                    (&current.spec, &current_refit),
+                    (&spec, &x),
+                    (&before_judged, &val_judged, &held_runs),
+                    cfg,
+                )?
+            } else {
+                None
+            };
+            let left_out_passes = left_out.is_some_and(|(g, n)| g > margin * cfg.gain_min.max(n));
+            if let Some((g, n)) = left_out {
+                second_look_left_out = Some((g, n, margin * cfg.gain_min.max(n), left_out_passes));
+            }
+            let passes = others_pass && (gain > margin * gain_needed || left_out_passes);
+            let gain = match left_out {
+                Some((g, _)) if left_out_passes => g,
+                _ => gain,
+            };
             second.record(&c.effect, passes, gain)
         } else {
             plausible
@@ -5920,6 +6037,15 @@ pub fn discover(
             ),
         };
         let mut row = row;
+        if let Some((g, n, needed, passes)) = second_look_left_out {
+            row.note.push_str(&format!(
+                "; the validate runs alone short of the bar, the identify runs left out one at a time (each judged by the models refitted on the others) join them: E_θ fall {:.1} % ± {:.1} %, {} {:.1} %",
+                100.0 * g,
+                100.0 * n,
+                if passes { "beyond" } else { "short of" },
+                100.0 * needed,
+            ));
+        }
         if let Some((d, h, _)) = accel_tilt {
             row.note.push_str(&format!(
                 "; the accelerometer's horizontal axis (its slope on the vertical one, tan δ, on each forced identify run) reads δ = {d:.4e} [{:.4e}, {:.4e}] rad",
