@@ -3039,12 +3039,6 @@ fn refit_with(
     (problem.full(&x), f)
 }
 
-/// The run a trajectory or a held-out piece belongs to: its own id, or the id of the run whose
-/// free segment before the shaker starts it is (`<run>-free`).
-fn parent_run(id: &str) -> &str {
-    id.strip_suffix("-free").unwrap_or(id)
-}
-
 /// The identify runs' own held-out view of a candidate the validate runs cannot judge: each
 /// moving identify run (its forced window and its free segment) left out in turn, the current
 /// model and the candidate's refitted on the trajectories of the others (`traj_runs`, `traj_ics`,
@@ -3077,7 +3071,10 @@ fn left_out_gain(
     if traj_ics.len() != 2 * traj_runs.len() {
         return Ok(None);
     }
-    let mut folds: Vec<&str> = traj_runs.iter().map(|r| parent_run(&r.id)).collect();
+    let mut folds: Vec<&str> = traj_runs
+        .iter()
+        .map(|r| pendulum_process::run::parent_run_id(&r.id))
+        .collect();
     folds.sort_unstable();
     folds.dedup();
     if folds.len() < 3 {
@@ -3087,7 +3084,7 @@ fn left_out_gain(
     let mut held: Vec<PreparedRun> = val.2.to_vec();
     for out in folds {
         let keep: Vec<usize> = (0..traj_runs.len())
-            .filter(|&j| parent_run(&traj_runs[j].id) != out)
+            .filter(|&j| pendulum_process::run::parent_run_id(&traj_runs[j].id) != out)
             .collect();
         let runs: Vec<PreparedRun> = keep.iter().map(|&j| traj_runs[j].clone()).collect();
         let ics: Vec<f64> = keep
@@ -3096,7 +3093,7 @@ fn left_out_gain(
             .collect();
         let left: Vec<PreparedRun> = id_held
             .iter()
-            .filter(|r| parent_run(&r.id) == out)
+            .filter(|r| pendulum_process::run::parent_run_id(&r.id) == out)
             .cloned()
             .collect();
         if left.is_empty() {

@@ -1316,11 +1316,10 @@ pub fn free_segments(
     let mut out = Vec::new();
     for fctx in &kept {
         for run in &fctx.runs {
-            // One "-free" (`free_segment_runs`' suffix): a run the user named "warm-free" is
-            // "warm-free-free" here.
-            let Some(omega_hz) = run
-                .id
-                .strip_suffix("-free")
+            // (A run the user named "warm-free" is "warm-free-free" here.)
+            let parent = pendulum_process::run::parent_run_id(&run.id);
+            let Some(omega_hz) = Some(parent)
+                .filter(|p| *p != run.id)
                 .and_then(|parent| ctx.alignments.get(parent))
                 .map(|a| a.omega_hz)
             else {

@@ -69,7 +69,7 @@ pub fn free_segment_runs(ctx: &Context) -> Vec<RunData> {
         let mut rig = run.rig.clone();
         rig.omega_hz = None;
         out.push(RunData {
-            id: format!("{}-free", run.id),
+            id: pendulum_process::run::free_segment_id(&run.id),
             role: run.role,
             rig,
             enc_t_s: run.enc_t_s[seg.clone()].to_vec(),

@@ -66,6 +66,22 @@ impl RunData {
     }
 }
 
+/// The id of run `run`'s free segment before its shaker starts, prepared as a run of its own
+/// (`pendulum identify --free-segments`, discover's refits and held-out judgement).
+pub fn free_segment_id(run: &str) -> String {
+    format!("{run}{FREE_SEGMENT_SUFFIX}")
+}
+
+/// The run a piece with id `id` belongs to: the run whose free segment it is
+/// ([`free_segment_id`]), or itself. One suffix only: a run the user named "warm-free" has the
+/// free segment "warm-free-free", whose run is "warm-free" (and "warm-free" itself reads as the
+/// free segment of a run "warm", so ask it only of ids known to be pieces of runs).
+pub fn parent_run_id(id: &str) -> &str {
+    id.strip_suffix(FREE_SEGMENT_SUFFIX).unwrap_or(id)
+}
+
+const FREE_SEGMENT_SUFFIX: &str = "-free";
+
 /// Linear interpolation of (xs, ys) at x, clamped at the ends; xs increasing.
 pub fn interp(xs: &[f64], ys: &[f64], x: f64) -> f64 {
     if xs.is_empty() {
@@ -81,4 +97,19 @@ pub fn interp(xs: &[f64], ys: &[f64], x: f64) -> f64 {
     let (x0, x1) = (xs[i - 1], xs[i]);
     let w = if x1 > x0 { (x - x0) / (x1 - x0) } else { 0.0 };
     ys[i - 1] + w * (ys[i] - ys[i - 1])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_free_segments_run_is_the_run_it_was_cut_from_even_when_that_names_itself_free() {
+        for run in ["r01", "warm-free", "a-free-b"] {
+            let free = free_segment_id(run);
+            assert_ne!(free, run);
+            assert_eq!(parent_run_id(&free), run);
+        }
+        assert_eq!(parent_run_id("r01"), "r01");
+    }
 }
