@@ -2169,6 +2169,34 @@ fn an_offset_on_a_pinned_base_is_not_refused_for_a_remainder_a_seventieth_its_si
     assert_found(&s, "encoder_offset", truth, 0.0, 0.002);
 }
 
+/// A 6.37e-3 N·m constant dry torque on a drawn design whose identify runs rest but one chaotic
+/// one (the every-effect survey's `coulomb_constant` k=1 at `SURVEY_DAMPING=drawn
+/// SURVEY_SEED=45`): the identify runs' rows put it at 5.50e-3 [4.96e-3, 6.03e-3], the validate
+/// runs' at 6.70e-3 [6.05e-3, 7.35e-3], so the screen's route refused it as following the run;
+/// the second look then refused its refit (6.83e-3) as disagreeing with the screen. A known miss
+/// (the identify rows' value 3.2 standard errors below the truth); what this test holds is that
+/// the report says both: the second look's row keeps the screen route's reason.
+#[test]
+#[ignore = "slow set (one drawn design, 30 s): the default suite checks each route's own words on the tests that name their reasons; README, Tests"]
+fn a_second_looks_row_keeps_the_screen_routes_reason() {
+    let (_, s) = run_as_surveyed_with_damping("coulomb_constant", 4_501_401, 4_509_401, 4_505_401);
+    for r in &s.discovery.rows {
+        eprintln!("note {}: {}", r.effect, r.note);
+    }
+    let row = s
+        .discovery
+        .row("coulomb_constant")
+        .expect("a coulomb_constant row");
+    assert!(!row.accepted);
+    assert!(row.note.starts_with("second look"), "{}", row.note);
+    assert!(
+        row.note
+            .contains("before it, on the screen's route, not named: interval excludes 0; the validate runs' own rows put its size elsewhere"),
+        "{}",
+        row.note
+    );
+}
+
 /// A 6.61e-3 N·m breakaway fading at 0.384 rad/s on a drawn design (the every-effect survey's
 /// `stribeck` k=4 at `SURVEY_DAMPING=drawn SURVEY_SEED=39`) whose validate runs hardly see it:
 /// refitted at 5.12e-3 on the identify runs, it took 20.7 % ± 10.5 % off their E_θ, short of twice

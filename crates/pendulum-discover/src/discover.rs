@@ -3901,6 +3901,9 @@ pub fn discover(
     let mut baseline: [Option<(Vec<f64>, Vec<RunFit>)>; 4] = [None, None, None, None];
     let mut rows: Vec<DiagnosisRow> = Vec::new();
     let mut confirmed: Vec<(String, DiagnosisRow)> = Vec::new();
+    // Each effect's latest refusal on the screen's route (its row's note), for the second look's
+    // row of the same effect.
+    let mut screen_route_refusals: std::collections::BTreeMap<String, String> = Default::default();
     let mut correction = Correction::default();
     // A tilt the screen cannot estimate on the identify runs' windows, read by the accelerometer
     // and judged by the pendulum ([`TiltJudge`]) before anything else: named, it is known, and
@@ -5971,9 +5974,9 @@ pub fn discover(
                 } else if second_look && after_pin.is_some() {
                     "second look (the model holding the first named effect was pinned at its search range; judged on the held-out runs and on whether the candidate's refit frees it)"
                 } else if second_look && free_segments_measure {
-                    "second look (the identify runs' equation error cannot see it; their free segments' pooled envelope holds the trajectories' value; judged on the held-out runs)"
+                    "second look (nothing named on the screen's route; the identify runs' free segments' pooled envelope holds the trajectories' value; judged on the held-out runs)"
                 } else if second_look {
-                    "second look (the identify runs' equation error cannot see it; judged on the held-out runs)"
+                    "second look (nothing named on the screen's route; judged on the trajectories and the held-out runs)"
                 } else if hanging_reads {
                     "interval excludes 0 (the free decays' centres, which hold the screen's value: the screen's own interval held 0)"
                 } else if excludes_zero {
@@ -6036,7 +6039,7 @@ pub fn discover(
         let mut row = row;
         if let Some((g, n, needed, passes)) = second_look_left_out {
             row.note.push_str(&format!(
-                "; the validate runs alone short of the bar, the identify runs left out one at a time (each judged by the models refitted on the others) join them: E_θ fall {:.1} % ± {:.1} %, {} {:.1} %",
+                "; the identify runs left out one at a time (each judged by the models refitted on the others) join the validate runs, short of the bar alone: E_θ fall {:.1} % ± {:.1} %, {} {:.1} %",
                 100.0 * g,
                 100.0 * n,
                 if passes { "beyond" } else { "short of" },
@@ -6286,6 +6289,22 @@ pub fn discover(
             if let Some(sh) = c.shaped() {
                 correction.shapes.insert(sh.col, c.shape);
             }
+        }
+        // The screen route's refusal stays in the second look's row: that route's reason (the
+        // validate runs' own rows putting a dry torque at 6.70e-3 N·m [6.05e-3, 7.35e-3] and
+        // the identify runs' at 5.50e-3 [4.96e-3, 6.03e-3]) is why the second look was asked,
+        // and the second look's own words alone ("the trajectory refit disagrees with the
+        // screen") hid it.
+        if second_look {
+            if let Some(first) = screen_route_refusals.get(&c.effect) {
+                row.note.push_str(&format!(
+                    "; (before it, on the screen's route, not named: {first})"
+                ));
+            }
+        } else if accepted {
+            screen_route_refusals.remove(&c.effect);
+        } else {
+            screen_route_refusals.insert(c.effect.clone(), row.note.clone());
         }
         // One row per effect, the latest judgement: the second look's accepted pass replaces its
         // evaluation, and a candidate tried again after another was accepted is judged anew.
