@@ -600,6 +600,7 @@ fn a_generator_refitted_to_nothing_below_its_screens_interval_is_not_named() {
 /// from the stuck base fit and stayed there. The gain was the start's, not the torque's: the
 /// absence of the effect is now refitted from the screen's start as well.
 #[test]
+#[ignore = "slow set (a false-alarm survey draw; about 57 s beside a survey): the default suite checks that nothing is named with nothing hidden on nothing_hidden_from_the_reference_base_on_a_mostly_resting_design_names_nothing and on the independent i00, i01 and i11; README, Tests"]
 fn a_dry_torque_is_not_credited_with_what_a_better_start_gives_the_base() {
     let mut r = rng(40);
     let (mut b, mut mu) = (0.0, 0.0);
@@ -1007,6 +1008,7 @@ fn a_run_whose_initial_state_a_gap_hides_is_left_out_not_the_campaign() {
 /// before the shakers start, where each run swings from its hand start, now join the refits:
 /// the generator is named within 10 %.
 #[test]
+#[ignore = "slow set (a survey draw, `generator_rectified` k=1 at SURVEY_SEED=2; about 45 s beside a survey): the default suite refits on the free segments on a_loss_the_free_segments_measure_where_the_forced_windows_cannot_is_named and names a generator on issue_15_finds_the_generator_when_hidden; README, Tests"]
 fn a_generator_whose_forced_identify_runs_all_rest_is_refitted_on_their_free_segments() {
     let truth = 0.035444419508140694;
     let s = discover(
@@ -3823,6 +3825,7 @@ fn a_damping_split_the_shaken_runs_leave_open_is_pinned_by_the_free_swings() {
 /// Campaign 2 of the same survey (a 0.013, b 0.377, μ 0.179): the free segments follow the base
 /// fit's damping about as well as their own, and the report says nothing of it.
 #[test]
+#[ignore = "slow set (a false-alarm survey draw; about 53 s beside a survey): the default suite checks the free swings' damping view on a_damping_split_the_shaken_runs_leave_open_is_pinned_by_the_free_swings, and the false-alarm survey tallies its verdicts; README, Tests"]
 fn free_swings_that_agree_with_the_base_fit_add_nothing_to_the_report() {
     let dir = tempfile::tempdir().unwrap();
     let (_, s) = false_alarm_campaign_with_drag(dir.path(), 900_000, 2);
