@@ -3961,8 +3961,9 @@ fn a_loss_the_free_segments_measure_where_the_forced_windows_cannot_is_named() {
     assert_found(&s, "coulomb_constant", truth, 0.10, 0.0);
     let row = s.discovery.row("coulomb_constant").unwrap();
     assert!(
-        row.note
-            .contains("their free segments' pooled envelope holds the trajectories' value"),
+        row.note.contains(
+            "the identify runs' free segments' pooled envelope holds the trajectories' value"
+        ),
         "{}",
         row.note
     );
