@@ -1318,9 +1318,9 @@ pub fn free_segments(
         for run in &fctx.runs {
             // (A run the user named "warm-free" is "warm-free-free" here.)
             let parent = pendulum_process::run::parent_run_id(&run.id);
-            let Some(omega_hz) = Some(parent)
-                .filter(|p| *p != run.id)
-                .and_then(|parent| ctx.alignments.get(parent))
+            let Some(omega_hz) = (parent != run.id)
+                .then(|| ctx.alignments.get(parent))
+                .flatten()
                 .map(|a| a.omega_hz)
             else {
                 continue;
