@@ -9,7 +9,7 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use pendulum_model::Effects;
-use pendulum_plot::{Figure, Panel, Series, SeriesStyle};
+use pendulum_plot::{floor_span, Figure, Panel, Series, SeriesStyle};
 use pendulum_process::fit::{FitParam, ModelSpec};
 use pendulum_process::identify::{FitOutcome, ResidualSeries, RunFit};
 use pendulum_process::pipeline::Context;
@@ -1115,6 +1115,14 @@ fn per_run_summary(text: &mut String, ctx: &Context, m: &FitOutcome) {
     }
 }
 
+/// The least span of a history plot's angle axis, rad (about 33 counts of a 4096-count encoder,
+/// 3°): a pendulum at rest is drawn as the flat line it is, its measured and simulated angles a
+/// fraction of a count apart side by side, not magnified into two lines across the panel.
+const HISTORY_MIN_SPAN_RAD: f64 = 0.05;
+
+/// The least span of a history plot's rate axis, rad/s (see [`HISTORY_MIN_SPAN_RAD`]).
+const HISTORY_MIN_SPAN_RAD_S: f64 = 0.5;
+
 fn history_plot(
     path: &Path,
     id: &str,
@@ -1141,6 +1149,10 @@ fn history_plot(
                     series("measured", &s.theta_meas, 0),
                     series("simulated", &s.theta_sim, 1),
                 ],
+                y_range: floor_span(
+                    s.theta_meas.iter().chain(&s.theta_sim).copied(),
+                    HISTORY_MIN_SPAN_RAD,
+                ),
                 ..Panel::default()
             },
             Panel {
@@ -1151,6 +1163,10 @@ fn history_plot(
                     series("measured", &s.theta_dot_meas, 0),
                     series("simulated", &s.theta_dot_sim, 1),
                 ],
+                y_range: floor_span(
+                    s.theta_dot_meas.iter().chain(&s.theta_dot_sim).copied(),
+                    HISTORY_MIN_SPAN_RAD_S,
+                ),
                 ..Panel::default()
             },
         ],

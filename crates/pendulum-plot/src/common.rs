@@ -286,6 +286,18 @@ pub fn finite_range(values: impl IntoIterator<Item = f64>) -> Option<(f64, f64)>
         })
 }
 
+/// A fixed y range no narrower than `min_span` for `values` (their finite ones) that span less,
+/// centred on them; `None` where they span at least that (fit the data as usual) or hold nothing
+/// finite. Fitted to the data, a trace that hardly moves is magnified to its rounding: a
+/// resting pendulum's measured and simulated angles, 1.4e-7 rad apart, filled the panel as two
+/// lines far apart.
+pub fn floor_span(values: impl IntoIterator<Item = f64>, min_span: f64) -> Option<(f64, f64)> {
+    let (lo, hi) = finite_range(values)?;
+    let mid = 0.5 * (lo + hi);
+    (hi - lo < min_span && min_span.is_finite())
+        .then(|| (mid - 0.5 * min_span, mid + 0.5 * min_span))
+}
+
 /// Widen a (finite) range by `frac` of its span on each side; an empty span gets a
 /// span of its own so the axis still has ticks.
 pub fn pad_range((lo, hi): (f64, f64), frac: f64) -> (f64, f64) {
@@ -614,6 +626,18 @@ mod tests {
         assert!(lo < -0.999 && hi > 0.999);
         assert_eq!(d.first(), pts.first());
         assert_eq!(d.last(), pts.last());
+    }
+
+    #[test]
+    fn a_trace_narrower_than_the_floor_is_drawn_at_the_floors_span_about_its_middle() {
+        let resting = [2.300_975e-3, 2.300_838e-3, f64::NAN, 2.300_838e-3];
+        let (lo, hi) = floor_span(resting, 0.05).unwrap();
+        assert!((hi - lo - 0.05).abs() < 1e-12, "{lo} {hi}");
+        assert!((0.5 * (lo + hi) - 0.5 * (2.300_975e-3 + 2.300_838e-3)).abs() < 1e-12);
+        // Wide enough already, or nothing to draw: the data's own range.
+        assert_eq!(floor_span([-1.0, 1.0], 0.05), None);
+        assert_eq!(floor_span([f64::NAN], 0.05), None);
+        assert_eq!(floor_span(std::iter::empty(), 0.05), None);
     }
 
     #[test]

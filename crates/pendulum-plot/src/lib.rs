@@ -27,7 +27,7 @@ mod scatter;
 
 use std::path::{Path, PathBuf};
 
-pub use common::{png_text_of, set_png_text};
+pub use common::{floor_span, png_text_of, set_png_text};
 pub use heatmap::save_heatmaps_side_by_side;
 
 /// Okabe–Ito colour-blind-safe palette, in the order series are coloured by default
