@@ -2,13 +2,13 @@
 //! the catalogue effect responsible (or say `unexplained`), extend the model, and measure the
 //! gain on runs the fit never saw.
 
+pub mod damping;
 pub mod discover;
 pub mod envelope;
 pub mod screen;
 pub mod sparse;
 pub mod weak;
 
-pub use discover::{
-    discover, DampingCheck, DampingVerdict, DiagnosisRow, DiscoverConfig, Discovery,
-};
+pub use damping::{DampingCheck, DampingVerdict};
+pub use discover::{discover, DiagnosisRow, DiscoverConfig, Discovery};
 pub use screen::Base;
