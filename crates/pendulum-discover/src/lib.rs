@@ -7,6 +7,7 @@ pub mod discover;
 pub mod envelope;
 pub mod screen;
 pub mod sparse;
+mod trajectories;
 pub mod weak;
 
 pub use damping::{DampingCheck, DampingVerdict};

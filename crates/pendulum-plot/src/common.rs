@@ -295,7 +295,7 @@ pub fn floor_span(values: impl IntoIterator<Item = f64>, min_span: f64) -> Optio
     let (lo, hi) = finite_range(values)?;
     let mid = 0.5 * (lo + hi);
     (hi - lo < min_span && min_span.is_finite())
-        .then(|| (mid - 0.5 * min_span, mid + 0.5 * min_span))
+        .then_some((mid - 0.5 * min_span, mid + 0.5 * min_span))
 }
 
 /// Widen a (finite) range by `frac` of its span on each side; an empty span gets a
