@@ -4,7 +4,7 @@
 use pendulum_process::fit::{ModelSpec, PreparedRun};
 use pendulum_process::identify::FitOutcome;
 
-use crate::discover::paired_gain;
+use crate::heldout::paired_gain;
 use crate::trajectories::{refit, substitution_segments, trajectory_substitution};
 
 /// What the identify runs' free segments before the shakers start say of the base model's

@@ -5,6 +5,7 @@
 pub mod damping;
 pub mod discover;
 pub mod envelope;
+mod heldout;
 pub mod screen;
 pub mod sparse;
 mod trajectories;

@@ -556,7 +556,7 @@ pub fn describe(
     };
     let before = crate::weak::sq_with_run_offsets(&val_rows, residuals(&base_cols, &coef0));
     let after = crate::weak::sq_with_run_offsets(&val_rows, residuals(&cols, &coef));
-    let (gain, noise) = crate::discover::paired_gain(&before, &after);
+    let (gain, noise) = crate::heldout::paired_gain(&before, &after);
     // The described torque at each identify row's centre, by variable.
     let terms: Vec<(usize, f64, f64)> = chosen
         .iter()
@@ -731,7 +731,7 @@ pub fn run_spread(
     let before =
         crate::weak::sq_with_run_offsets(&held_rows, test.iter().map(|&i| residual[i]).collect());
     let after = crate::weak::sq_with_run_offsets(&held_rows, after);
-    let (heldout_gain, heldout_noise) = crate::discover::paired_gain(&before, &after);
+    let (heldout_gain, heldout_noise) = crate::heldout::paired_gain(&before, &after);
     Some(RunSpread {
         heldout_gain,
         heldout_noise,
@@ -774,7 +774,7 @@ pub struct FamilyComparison {
     pub fit_over_candidate: f64,
     /// Where the description holds a [`CONFIRMED_ONLY`] term: the validate rows' fall of their
     /// squared equation error from the candidate's fit to the description's (both fitted on the
-    /// identify rows), its noise ([`crate::discover::paired_gain`]), and the candidate's share of
+    /// identify rows), its noise ([`crate::heldout::paired_gain`]), and the candidate's share of
     /// the description's fall from the current model there. Present only where it confirms
     /// ([`HeldOutComparison::confirms`]).
     pub heldout_over_candidate: Option<HeldOutComparison>,
@@ -973,7 +973,7 @@ pub fn family_beats_candidate(
         freer.extend(chosen);
         let (before, with_cand, with_freer) =
             (sq(&base, j_base)?, sq(&cand, j_cand)?, sq(&freer, j_desc)?);
-        let (gain, noise) = crate::discover::paired_gain(&with_cand, &with_freer);
+        let (gain, noise) = crate::heldout::paired_gain(&with_cand, &with_freer);
         // Each one's fall from the current model on the validate rows.
         let sum = |v: &[f64]| v.iter().sum::<f64>();
         let fall = |v: &[f64]| 1.0 - sum(v) / sum(&before).max(1e-300);

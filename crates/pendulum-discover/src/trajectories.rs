@@ -8,7 +8,7 @@ use pendulum_fit::{Cost, Problem};
 use pendulum_process::fit::{ModelSpec, PreparedRun, StudyObjective};
 use pendulum_process::identify::FitOutcome;
 
-use crate::discover::paired_gain;
+use crate::heldout::paired_gain;
 
 /// `x` inside the bounds the refit keeps its parameters to.
 pub(crate) fn clamped(spec: &ModelSpec, x: &[f64]) -> Vec<f64> {

@@ -1,0 +1,179 @@
+//! The held-out judgement's arithmetic: a paired fall over units (0.5 s shooting segments for
+//! E_θ, weak-form windows for the equation error) and the noise it must beat, the margins a lone
+//! view must clear, and which segments an effect's E_θ is judged on.
+
+use pendulum_model::effects::Kind;
+use pendulum_process::fit::PreparedRun;
+use pendulum_process::identify::RunFit;
+
+use crate::trajectories::{angle_span, quantisation_step, STILL_TAIL_STEPS};
+
+/// A second look at the dry frictions, after the screen named nothing. A dry friction acts most
+/// where the pendulum slows, turns and sticks, and the equation-error view leaves out exactly
+/// the windows where it may stick (their friction is static and unknown): a breakaway torque
+/// (stribeck) shows in the trajectories, in how and where the runs come to rest, while its
+/// screen's ΔBIC stays near 0 (a survey case at +5.0 whose refit took 70 % off the held-out
+/// E_θ). So every first-round candidate that sets the sticking capacity
+/// ([`pendulum_model::Effect::sets_sticking_capacity`]) and does not fit the equation error
+/// worse is refitted and judged on held-out evidence alone: physically possible, agreeing with
+/// the screen (whose interval is wide here, so this is a weak check), a held-out E_θ fall
+/// beyond [`SECOND_LOOK_GAIN_FACTOR`] times the screen route's bar, and the validate runs'
+/// equation error falling beyond its noise too (both held-out views). They are alternatives (a constant dry torque and a breakaway both
+/// hold the pendulum at rest), so all are evaluated first and only the one with the largest
+/// held-out fall is then accepted (re-evaluated, deterministically, to build its model).
+/// How many times the screen route's held-out bar (the larger of the smallest gain and the
+/// paired noise, itself 1.96 standard errors) the second look's held-out E_θ fall must beat,
+/// because the identify runs' equation error cannot stand beside it and two or three dry
+/// frictions are tried on every campaign where nothing else is named. (Nominally 3.9 standard
+/// errors; the segments of one run are not independent, so the real margin is smaller: falls at
+/// 2.2 and 2.4 times their noise came from nothing on drawn designs, which is why the validate
+/// runs' equation error must agree as well.)
+pub const SECOND_LOOK_GAIN_FACTOR: f64 = 2.0;
+
+/// A fall (a fraction of an error taken off) that clears `bar` `factor` times over: a fall is a
+/// ratio, after / before = 1 − fall, and ratios compound, so `factor` falls of `bar` in a row
+/// leave (1 − bar)^factor. Unlike `factor` × `bar` it stays below 1 for any bar below 1: a
+/// view whose noise is 78.5 % can still confirm by 95.4 %.
+pub(crate) fn fall_by_factor(bar: f64, factor: f64) -> f64 {
+    1.0 - (1.0 - bar.min(1.0)).powf(factor)
+}
+
+/// The z a held-out view's signed ranks must pass to clear their bar `factor` times over: the
+/// chance of a pass under the null, one in forty at [`HELDOUT_Z`], raised to `factor` (as
+/// [`fall_by_factor`] squares what a fall leaves): 3.23 for twice.
+pub(crate) fn rank_z_by_factor(factor: f64) -> f64 {
+    pendulum_numerics::normal_quantile(1.0 - pendulum_numerics::normal_sf(HELDOUT_Z).powf(factor))
+}
+
+pub(crate) fn e_total(v: &[RunFit]) -> f64 {
+    v.iter().map(|r| r.e_theta).sum()
+}
+
+/// z of the one-sided 97.5 % bound a held-out gain must clear.
+pub(crate) const HELDOUT_Z: f64 = 1.96;
+
+/// A paired held-out comparison: the fractional fall 1 − Σafter/Σbefore over paired units, and
+/// the noise it must beat, z × its standard error from the spread of the paired differences
+/// (infinite with fewer than three units: nothing can be told apart then).
+///
+/// The spread of the differences is the fall's scatter under the null (no change: each unit's
+/// difference is as likely either way), which is what "a fall the units' own scatter could
+/// produce by chance" asks. It is not the sampling error of the fall itself: that is the ratio
+/// estimator's (the spread of d − g·before, which the bootstrap over units reproduces), far
+/// smaller where every unit falls in proportion (a k = 49 cogging torque's 98.3 % equation-error
+/// fall was judged against 116 %). Tried in abbfb5e and undone: the bars that use this noise for
+/// a rise too ("E_θ may not rise by more than its noise") then vetoed effects the equation error
+/// confirmed wherever the validate runs rest (E_θ 0.019 → 0.033 rad on runs at rest became a
+/// significant −74 % ± 1.7 %), and the surveys lost more campaigns than they gained (first
+/// draws +1, other draws −1, third draws −2 in their first 25, one departure's `unexplained`).
+/// Changing it means giving those bars their own null noise and a floor for runs at rest.
+pub(crate) fn paired_gain(before: &[f64], after: &[f64]) -> (f64, f64) {
+    let n = before.len().min(after.len());
+    let sb: f64 = before[..n].iter().sum();
+    let sa: f64 = after[..n].iter().sum();
+    let gain = 1.0 - sa / sb.max(1e-300);
+    if n < 3 {
+        return (gain, f64::INFINITY);
+    }
+    let d: Vec<f64> = (0..n).map(|i| before[i] - after[i]).collect();
+    let mean = d.iter().sum::<f64>() / n as f64;
+    let var = d.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n as f64 - 1.0);
+    (gain, HELDOUT_Z * (n as f64 * var).sqrt() / sb.max(1e-300))
+}
+
+/// Paired units of two validations of the same runs: their multiple-shooting segments, which
+/// restart from the measured state and so err nearly independently (a run whose segments do not
+/// pair up, e.g. after a re-alignment, counts as one unit).
+/// `still`: per run id, which of its segments to leave out (see [`heldout_gain_in_motion`]).
+pub(crate) fn segment_pairs(
+    before: &[RunFit],
+    after: &[RunFit],
+    still: &[(String, Vec<bool>)],
+) -> (Vec<f64>, Vec<f64>) {
+    let (mut b, mut a) = (Vec::new(), Vec::new());
+    for rb in before {
+        let Some(ra) = after.iter().find(|r| r.id == rb.id) else {
+            continue;
+        };
+        if !rb.segment_e.is_empty() && rb.segment_e.len() == ra.segment_e.len() {
+            let mask = still
+                .iter()
+                .find(|(id, m)| *id == rb.id && m.len() == rb.segment_e.len())
+                .map(|(_, m)| m.as_slice());
+            for (k, (eb, ea)) in rb.segment_e.iter().zip(&ra.segment_e).enumerate() {
+                if !mask.is_some_and(|m| m[k]) {
+                    b.push(*eb);
+                    a.push(*ea);
+                }
+            }
+        } else {
+            b.push(rb.e_theta);
+            a.push(ra.e_theta);
+        }
+    }
+    (b, a)
+}
+
+/// The held-out E_θ gain of `after` over `before` (each as `effect`'s judgement sees them,
+/// [`judged_for`]) and its noise: where the pendulum moves for a torque that vanishes at rest
+/// (a loss that sets no sticking capacity, [`heldout_gain_in_motion`]), over every segment
+/// otherwise.
+pub(crate) fn effect_heldout_gain(
+    effect: &dyn pendulum_model::effects::Effect,
+    before: &[RunFit],
+    after: &[RunFit],
+    held_runs: &[PreparedRun],
+) -> (f64, f64) {
+    let only_in_motion =
+        effect.kind() == Kind::Dynamics && effect.positive() && !effect.sets_sticking_capacity();
+    if only_in_motion {
+        heldout_gain_in_motion(before, after, held_runs)
+    } else {
+        heldout_gain(before, after)
+    }
+}
+
+/// Held-out E_θ gain of `after` over `before` and the noise it must beat (discover's held-out
+/// test; public so that a survey can ask the same of the truth itself).
+pub fn heldout_gain(before: &[RunFit], after: &[RunFit]) -> (f64, f64) {
+    let (b, a) = segment_pairs(before, after, &[]);
+    paired_gain(&b, &a)
+}
+
+/// [`heldout_gain`] over the segments in which the measured pendulum moves (`runs`: the validated
+/// runs). A segment over which it stays at rest tells only whether the model holds it there:
+/// whether the restart angle, quantised and off by the run's few counts of zeroing error, lies
+/// inside the model's sticking zone. A torque that vanishes at rest does not change that zone;
+/// only the other terms' refit along it does. A hidden viscous damping (b = 0.585 N·s/m) on a
+/// drawn design, screened at 0.586 (equation error −100 %) and refitted at 0.584, was refused on
+/// an E_θ rise of 286 % ± 148 %: the dry base, its μ at 1.35 for want of the damping, held a
+/// validate run at rest under 12 m/s² of shaking that the true μ 0.15, restarted a few counts
+/// off, let slide into its parametric resonance.
+pub(crate) fn heldout_gain_in_motion(
+    before: &[RunFit],
+    after: &[RunFit],
+    runs: &[PreparedRun],
+) -> (f64, f64) {
+    let still: Vec<(String, Vec<bool>)> = runs
+        .iter()
+        .map(|r| (r.id.clone(), still_segments(r)))
+        .collect();
+    let (b, a) = segment_pairs(before, after, &still);
+    paired_gain(&b, &a)
+}
+
+/// Per multiple-shooting segment of `run` ([`PreparedRun::segment_ranges`]): whether its measured
+/// angle stays within [`STILL_TAIL_STEPS`] encoder steps throughout.
+pub(crate) fn still_segments(run: &PreparedRun) -> Vec<bool> {
+    // (An angle that never changes has no step: every segment is still.)
+    let step = quantisation_step(&run.theta);
+    let tol = if step.is_finite() {
+        STILL_TAIL_STEPS * step
+    } else {
+        0.0
+    };
+    run.segment_ranges()
+        .into_iter()
+        .map(|r| angle_span(&run.theta[r]) <= tol + 1e-12)
+        .collect()
+}
