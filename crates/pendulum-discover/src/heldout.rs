@@ -177,3 +177,49 @@ pub(crate) fn still_segments(run: &PreparedRun) -> Vec<bool> {
         .map(|r| angle_span(&run.theta[r]) <= tol + 1e-12)
         .collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A fall cleared `factor` times over is two falls in a row: the error left after both is
+    /// the product of what each leaves. Factor 1 is the bar itself, and no bar below 100 % asks
+    /// for 100 % or more (twice a 78.5 % bar, linearly, would ask for 157 %).
+    #[test]
+    fn a_fall_cleared_twice_leaves_the_square_of_what_one_leaves() {
+        for bar in [0.05, 0.241, 0.5, 0.785, 0.999] {
+            assert!((fall_by_factor(bar, 1.0) - bar).abs() < 1e-15);
+            let twice = fall_by_factor(bar, 2.0);
+            assert!(((1.0 - twice) - (1.0 - bar) * (1.0 - bar)).abs() < 1e-15);
+            assert!(twice > bar && twice < 1.0, "bar {bar}: {twice}");
+        }
+        assert!((fall_by_factor(0.241, 2.0) - 0.423_919).abs() < 1e-6);
+        assert_eq!(fall_by_factor(1.5, 2.0), 1.0);
+    }
+
+    /// The ranks' margin: once is the one-sided 97.5 % z itself; twice is the chance of one in
+    /// forty squared (1/1600 → z = 3.2272, from any normal table).
+    #[test]
+    fn the_ranks_cleared_twice_pass_the_square_of_the_chance_once() {
+        assert!((rank_z_by_factor(1.0) - HELDOUT_Z).abs() < 1e-9);
+        let p = pendulum_numerics::normal_sf(HELDOUT_Z);
+        assert!((pendulum_numerics::normal_sf(rank_z_by_factor(2.0)) - p * p).abs() < 1e-12);
+        assert!((rank_z_by_factor(2.0) - 3.2272).abs() < 1e-3);
+    }
+
+    /// The paired held-out gain: its value, and a noise equal to 1.96 standard errors of the
+    /// summed differences, computed by hand.
+    #[test]
+    fn paired_gain_matches_hand_computation() {
+        let before = [1.0, 2.0, 3.0, 4.0];
+        let after = [0.5, 1.5, 3.0, 3.0];
+        let (g, noise) = paired_gain(&before, &after);
+        assert!((g - (1.0 - 8.0 / 10.0)).abs() < 1e-15);
+        // d = [0.5, 0.5, 0, 1]: mean 0.5, sample variance 1/6.
+        let se_sum = (4.0_f64 / 6.0).sqrt();
+        assert!((noise - 1.96 * se_sum / 10.0).abs() < 1e-15);
+        // A uniform fall has no scatter; two units cannot be judged.
+        assert_eq!(paired_gain(&[1.0; 5], &[0.9; 5]).1, 0.0);
+        assert!(paired_gain(&[1.0, 2.0], &[0.5, 1.0]).1.is_infinite());
+    }
+}

@@ -6,6 +6,7 @@ pub mod damping;
 pub mod discover;
 pub mod envelope;
 mod heldout;
+mod readings;
 pub mod screen;
 pub mod sparse;
 mod trajectories;
