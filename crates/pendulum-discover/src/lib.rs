@@ -4,6 +4,7 @@
 
 pub mod damping;
 pub mod discover;
+mod drift;
 pub mod envelope;
 mod heldout;
 mod readings;

@@ -672,4 +672,32 @@ mod tests {
         assert!(lo < 0.0 && hi > 0.0, "[{lo}, {hi}]");
         assert!(hanging_interval(&seed4[..2]).is_none());
     }
+
+    /// A named sensor effect's value from every run's reading, by hand: the mean of identify
+    /// and validate readings less the nominal, its interval Student's t over their scatter;
+    /// a row not named, or one without validate readings, keeps the identify runs' value.
+    #[test]
+    fn a_named_sensor_effect_is_sized_on_every_runs_reading() {
+        let mut row = DiagnosisRow::words_only("accel_gain", "1", String::new());
+        row.estimate = 0.2;
+        row.identify_estimate = 0.2;
+        let (id, val) = ([1.1, 1.2, 1.3], [1.4, 1.5]);
+        pool_readings(&mut row, &id, &val, 1.0);
+        assert_eq!(row.estimate, 0.2, "not named: unchanged");
+        row.accepted = true;
+        pool_readings(&mut row, &id, &[], 1.0);
+        assert_eq!(row.estimate, 0.2, "no validate readings: unchanged");
+        pool_readings(&mut row, &id, &val, 1.0);
+        assert!((row.estimate - 0.3).abs() < 1e-12, "{}", row.estimate);
+        // Readings 1.1..1.5: sample variance 0.025, standard error sqrt(0.025 / 5); t(4) = 2.776.
+        let half = 2.776 * (0.025_f64 / 5.0).sqrt();
+        assert!((row.ci_high - row.estimate - half).abs() < 2e-3 * half);
+        assert!((row.estimate - row.ci_low - half).abs() < 2e-3 * half);
+        assert_eq!(row.identify_estimate, 0.2);
+        assert!(
+            row.note.contains("the identify runs alone: 2.0000e-1"),
+            "{}",
+            row.note
+        );
+    }
 }
