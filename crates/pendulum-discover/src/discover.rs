@@ -46,6 +46,7 @@ use crate::readings::{
     accel_gain_row, hanging_interval, hangs_as_an_offset, horizontal_slopes, joined_with_reading,
     per_run_mean, sensor_heldout, t95, tilt_reading, zeroing_half, TiltJudge, SENSOR_HELDOUT_GAIN,
 };
+use crate::residual::{anova, bin_means_heldout, RESIDUAL_VARIABLES};
 use crate::screen::{ols, stepwise, stepwise_from, with_candidate, Base, Candidate, Screened};
 use crate::trajectories::{
     followed_ics, is_moving, moving_runs, pooled_refit, refit, refit_objective, refit_profile,
@@ -1785,136 +1786,6 @@ fn without_effect(spec: &ModelSpec, x: &[f64], name: &str) -> (ModelSpec, Vec<f6
         .map(|(v, _)| *v)
         .collect();
     (out, xs)
-}
-
-/// The variables a remaining equation error is binned against (effects.md's list, "the run"
-/// aside): the campaign's identify rows use the first three; the rows of runs the model does not
-/// follow use all.
-#[allow(clippy::type_complexity)]
-const RESIDUAL_VARIABLES: [(&str, fn(&WeakRow) -> f64); 5] = [
-    ("dθ/dt", |r| r.theta_dot_rad_s),
-    ("θ (mod 2π)", |r| {
-        r.theta.rem_euclid(2.0 * std::f64::consts::PI)
-    }),
-    ("forcing phase", |r| r.phase),
-    ("θ (unwrapped)", |r| r.theta),
-    ("time", |r| r.tau_s),
-];
-
-/// The rows with a finite `key` and `res`, sorted by `key` and cut into `bins` equal-count bins;
-/// `None` with fewer than ten rows a bin.
-fn equal_count_bins(key: &[f64], res: &[f64], bins: usize) -> Option<Vec<Vec<usize>>> {
-    let mut idx: Vec<usize> = (0..key.len())
-        .filter(|&i| key[i].is_finite() && res[i].is_finite())
-        .collect();
-    if bins == 0 || idx.len() < bins * 10 {
-        return None;
-    }
-    idx.sort_by(|&a, &b| key[a].total_cmp(&key[b]));
-    let n = idx.len();
-    Some(
-        (0..bins)
-            .map(|b| idx[b * n / bins..(b + 1) * n / bins].to_vec())
-            .collect(),
-    )
-}
-
-/// One-way ANOVA F statistic of `res` grouped into `bins` equal-count bins of `key`, and an
-/// approximate p-value (Wilson–Hilferty normal approximation of the F tail).
-fn anova(key: &[f64], res: &[f64], bins: usize) -> Option<(f64, f64)> {
-    let groups = equal_count_bins(key, res, bins)?;
-    let n: usize = groups.iter().map(Vec::len).sum();
-    let mean = groups.iter().flatten().map(|&i| res[i]).sum::<f64>() / n as f64;
-    let (mut ssb, mut ssw) = (0.0, 0.0);
-    for g in &groups {
-        let m = g.iter().map(|&i| res[i]).sum::<f64>() / g.len() as f64;
-        ssb += g.len() as f64 * (m - mean).powi(2);
-        ssw += g.iter().map(|&i| (res[i] - m).powi(2)).sum::<f64>();
-    }
-    let (d1, d2) = ((bins - 1) as f64, (n - bins) as f64);
-    let f = (ssb / d1) / (ssw / d2).max(1e-300);
-    Some((f, pendulum_numerics::f_sf(f, d1, d2)))
-}
-
-/// The bin means of `res` over `key` in [`anova`]'s equal-count bins, each weighted by the rows'
-/// `weight` (the inverse variance the held-out squares are weighted by: an unweighted mean is
-/// carried by the noisiest, fastest rows), as (each bin's largest key, its mean); `None` with
-/// fewer than ten rows a bin.
-fn bin_means(key: &[f64], res: &[f64], weight: &[f64], bins: usize) -> Option<Vec<(f64, f64)>> {
-    let groups = equal_count_bins(key, res, bins)?;
-    Some(
-        groups
-            .iter()
-            .map(|g| {
-                let (swe, sw) = g.iter().fold((0.0, 0.0), |(a, b), &i| {
-                    (a + weight[i] * res[i], b + weight[i])
-                });
-                (key[g[g.len() - 1]], if sw > 0.0 { swe / sw } else { 0.0 })
-            })
-            .collect(),
-    )
-}
-
-/// A one-way structure of the remaining equation error over a variable (`key` of every row of
-/// `rows`), judged on rows the bin means were not taken from, as a catalogue effect is judged on
-/// held-out runs: the validate rows against the identify rows' bin means, and each identify run
-/// against the other identify runs' (so that a campaign whose validate runs rest still has
-/// held-out rows). Each held-out row's residual less the mean of the bin its own key falls in
-/// (the outer bins open); the fall of their weighted squared equation error, each run's zeroing
-/// error refitted, with its noise ([`paired_gain`]). `None` without held-out rows.
-fn bin_means_heldout(
-    rows: &[WeakRow],
-    key: &[f64],
-    res: &[f64],
-    is_identify: &[bool],
-    is_validate: &[bool],
-    bins: usize,
-) -> Option<(f64, f64)> {
-    let id_runs = crate::weak::runs_of(rows, is_identify);
-    // (rows the means come from, rows they are judged on)
-    let folds = std::iter::once((
-        (0..rows.len())
-            .filter(|&i| is_identify[i])
-            .collect::<Vec<usize>>(),
-        (0..rows.len())
-            .filter(|&i| is_validate[i])
-            .collect::<Vec<usize>>(),
-    ))
-    .chain(id_runs.iter().map(|&run| {
-        let (held, from): (Vec<usize>, Vec<usize>) = (0..rows.len())
-            .filter(|&i| is_identify[i])
-            .partition(|&i| rows[i].run == run);
-        (from, held)
-    }));
-    let finite = |v: f64| if v.is_finite() { v } else { 0.0 };
-    let (mut before, mut after) = (Vec::new(), Vec::new());
-    for (from, held) in folds {
-        if held.len() < 3 {
-            continue;
-        }
-        let k: Vec<f64> = from.iter().map(|&i| key[i]).collect();
-        let e: Vec<f64> = from.iter().map(|&i| res[i]).collect();
-        let w: Vec<f64> = from.iter().map(|&i| rows[i].weight).collect();
-        let Some(means) = bin_means(&k, &e, &w, bins) else {
-            continue;
-        };
-        let predict = |k: f64| -> f64 {
-            if !k.is_finite() {
-                return 0.0;
-            }
-            let b = means.iter().position(|&(u, _)| k <= u);
-            means[b.unwrap_or(means.len() - 1)].1
-        };
-        let held_rows: Vec<&WeakRow> = held.iter().map(|&i| &rows[i]).collect();
-        let e0: Vec<f64> = held.iter().map(|&i| finite(res[i])).collect();
-        let e1: Vec<f64> = held
-            .iter()
-            .map(|&i| finite(res[i]) - predict(key[i]))
-            .collect();
-        before.extend(crate::weak::sq_with_run_offsets(&held_rows, e0));
-        after.extend(crate::weak::sq_with_run_offsets(&held_rows, e1));
-    }
-    (!before.is_empty()).then(|| paired_gain(&before, &after))
 }
 
 /// Runs discovery on a context whose pipeline has aligned the runs, estimated initial states and

@@ -8,6 +8,7 @@ mod drift;
 pub mod envelope;
 mod heldout;
 mod readings;
+mod residual;
 pub mod screen;
 pub mod sparse;
 mod trajectories;
