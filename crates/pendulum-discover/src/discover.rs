@@ -41,6 +41,8 @@ use crate::heldout::{
     e_total, effect_heldout_gain, fall_by_factor, paired_gain, rank_z_by_factor, HELDOUT_Z,
 };
 pub use crate::heldout::{heldout_gain, SECOND_LOOK_GAIN_FACTOR};
+pub use crate::looks::PINNED_LOOK;
+use crate::looks::{PairLook, SecondLook};
 pub use crate::readings::ACCEL_GAIN_FLOOR;
 use crate::readings::{
     accel_gain_row, hanging_interval, hangs_as_an_offset, horizontal_slopes, joined_with_reading,
@@ -228,7 +230,7 @@ impl Discovery {
 /// Exact corrections of the measured motion for accepted effects that enter the equation of
 /// motion nonlinearly.
 #[derive(Debug, Clone, Default, PartialEq)]
-struct Correction {
+pub(crate) struct Correction {
     /// Encoder offset, rad: the view uses θ_meas − θ_off.
     theta_off_rad: f64,
     /// Accelerometer lag, s: the forcing's t = 0 is the measured one minus Δ.
@@ -260,7 +262,7 @@ enum FitOn {
 /// contrasts and regression weights), which run each belongs to, and the identify and validate
 /// subsets.
 #[derive(Debug, Clone)]
-struct View {
+pub(crate) struct View {
     weak: Vec<WeakRow>,
     weak_runs: Vec<(String, Role)>,
     zero_cols: Vec<usize>,
@@ -1104,209 +1106,9 @@ fn extend(
     (out, news)
 }
 
-/// The second look when the base model's own fit is pinned at its search range: the model in
-/// hand does not follow the runs at all, and the screen may not see why. A hidden 0.05 rad
-/// encoder offset on a heavily damped design (b 0.5 N·s/m, μ 0.15, every forced stretch at
-/// rest) read as a pendulum held off vertical by friction: the base fit went to b = 1 and
-/// μ = 0.25, its bounds, while the equation error, which leaves out the windows where the
-/// pendulum may stick, had too few swings to see the offset (ΔBIC +4.2, an estimate right to
-/// 0.4 % inside an interval of ±0.24 rad). Then every first-round candidate is refitted, and
-/// judged as the dry frictions' second look is, except that the identify runs' own view may
-/// stand in for the validate runs' equation error: the candidate's refit takes every base
-/// parameter off the bounds that pinned it (the screen's joint estimate of the damping beside
-/// the candidate is where that refit starts). A model that then fits is the identify runs'
-/// verdict, the held-out E_θ fall beyond twice its bar the validate runs'.
-pub const PINNED_LOOK: &str = "the base model's fit was pinned at its search range";
-
-/// How far above 0 a replacement's ΔBIC may sit and still be equal to the column it replaces:
-/// a column identical to it on every window gives 0 up to the rounding of two sums of squares
-/// of a few hundred rows (7.1e-14 measured); any real difference of fit is orders above.
-const REPLACEMENT_DELTA_BIC_ROUNDING: f64 = 1e-9;
-
-enum SecondLook {
-    NotStarted,
-    /// Evaluating the queue; (effect, passes, held-out gain) so far.
-    Evaluating(
-        std::collections::VecDeque<Screened>,
-        Vec<(String, bool, f64)>,
-    ),
-    /// Re-evaluating the best to accept it.
-    Accepting(String, Vec<(String, bool, f64)>),
-    Done(Vec<(String, bool, f64)>),
-}
-
-impl SecondLook {
-    /// The next candidate to evaluate, starting the look when `eligible` (nothing named or
-    /// refused by the screen's own route).
-    /// With the base model pinned at its search range (`pinned`), every first-round candidate is
-    /// looked at again, not only the dry frictions (see [`PINNED_LOOK`]).
-    fn next(&mut self, eligible: bool, pinned: bool, first_round: &[Screened]) -> Option<Screened> {
-        if let SecondLook::NotStarted = self {
-            if !eligible {
-                return None;
-            }
-            let mut seen = std::collections::BTreeSet::new();
-            let queue = first_round
-                .iter()
-                .filter(|s| {
-                    (pinned
-                        || pendulum_model::effects::by_name(&s.candidate.effect)
-                            .is_some_and(|e| e.sets_sticking_capacity()))
-                        // A replacement (the bearing load) must not fit the equation error worse
-                        // than the column it replaces (added columns never do). Equal is not
-                        // worse, to rounding: where every identify window is free (each run
-                        // resting under its shaker) the bearing load's column is the bearing's
-                        // own, and its ΔBIC 7.1e-14 (the every-effect survey's
-                        // `bearing_load_base_accel` k=1 at `SURVEY_DAMPING=drawn
-                        // SURVEY_SEED=35`, whose forced runs the base fit follows with μ 0.248
-                        // against the free swings' 0.183).
-                        && (s.candidate.replaces.is_none()
-                            || s.delta_bic <= REPLACEMENT_DELTA_BIC_ROUNDING)
-                        && seen.insert(s.candidate.effect.clone())
-                })
-                .cloned()
-                .collect();
-            *self = SecondLook::Evaluating(queue, Vec::new());
-        }
-        match std::mem::replace(self, SecondLook::Done(Vec::new())) {
-            SecondLook::Evaluating(mut queue, results) => {
-                if let Some(s) = queue.pop_front() {
-                    *self = SecondLook::Evaluating(queue, results);
-                    return Some(s);
-                }
-                let best = results
-                    .iter()
-                    .filter(|r| r.1)
-                    .max_by(|a, b| a.2.total_cmp(&b.2))
-                    .map(|r| r.0.clone());
-                match best {
-                    Some(e) => {
-                        let s = first_round
-                            .iter()
-                            .find(|s| s.candidate.effect == e)
-                            .cloned();
-                        *self = SecondLook::Accepting(e, results);
-                        s
-                    }
-                    None => {
-                        *self = SecondLook::Done(results);
-                        None
-                    }
-                }
-            }
-            SecondLook::Accepting(_, results) | SecondLook::Done(results) => {
-                *self = SecondLook::Done(results);
-                None
-            }
-            SecondLook::NotStarted => None,
-        }
-    }
-
-    /// Records an evaluation; whether to accept it now (only when re-evaluating the best).
-    fn record(&mut self, effect: &str, passes: bool, gain: f64) -> bool {
-        match self {
-            SecondLook::Evaluating(_, results) => {
-                results.push((effect.to_string(), passes, gain));
-                false
-            }
-            SecondLook::Accepting(e, _) => passes && e == effect,
-            _ => false,
-        }
-    }
-
-    fn results(&self) -> &[(String, bool, f64)] {
-        match self {
-            SecondLook::Evaluating(_, r) | SecondLook::Accepting(_, r) | SecondLook::Done(r) => r,
-            SecondLook::NotStarted => &[],
-        }
-    }
-
-    fn evaluated(&self, effect: &str) -> bool {
-        self.results().iter().any(|r| r.0 == effect)
-    }
-
-    /// What the rows of the candidates not accepted should add, once the look is over.
-    fn verdict(&self) -> Option<String> {
-        let r = self.results();
-        if r.is_empty() {
-            return None;
-        }
-        let best = r.iter().filter(|x| x.1).max_by(|a, b| a.2.total_cmp(&b.2));
-        Some(match best {
-            Some((e, _, g)) => format!(
-                "; second look: {e} explains the held-out runs better ({:.1} % E_θ fall)",
-                100.0 * g
-            ),
-            None => "; second look: not confirmed by the trajectories".into(),
-        })
-    }
-}
-
 /// The largest regressor group (position_torque's k) in the whole-catalogue fit the weights come
 /// from (see [`crate::weak::set_weights`]).
 const WEIGHT_FIT_MAX_GROUP: u32 = 4;
-
-/// The pair look. Two effects hidden together can each fail the held-out views alone, because
-/// the other's unmodelled part spoils them: an 11.6 ms accelerometer lag beside a 0.039 rad
-/// tilted base, both screened at once (ΔBIC −737 and −788), were each refused on their own, the
-/// lag's validate-run equation error falling 33.6 % (35.4 % needed) and the tilt's 17.5 %
-/// (28.4 % needed), while beside each other's column they fell 98.7 % and 98.4 %. So when the
-/// screen route's candidate is refused on the held-out views alone (everything else passed:
-/// physically possible, the refit agreeing, not a partial explanation), and beside the next
-/// screened candidate's column each one's held-out equation-error fall clears its own bar, the
-/// first is held provisionally and the second judged beside it by every check. The pair is
-/// named only if the second passes, the first passes beside the second as well (its size
-/// refitted to 0 in the model holding both, the other terms refitted, must not do better on the
-/// validate runs' E_θ beyond its noise), and the pair together takes more than its bar off the
-/// validate runs' E_θ of the model before it: both held-out views. (Without that last bar an
-/// encoder counting 7 % under its header was named a 0.039 kg·m² extra inertia and a 1.8 N·m
-/// position torque together, on the equation error alone, while the validate runs' E_θ moved
-/// 2.2 %; the lag and the tilt above take 67.9 % off it, 18.7 % needed.) Otherwise everything returns to where
-/// the first's refusal left it, and the second is judged alone as before. Once per campaign.
-struct PairLook {
-    /// The first candidate, held provisionally.
-    first: String,
-    /// Where the first was refused alone as a partial explanation (a freer shape did better, or
-    /// the runs' own damping factors still disagreed with it in): its candidate, whose size is
-    /// then read again beside the second (alone it took up part of the other's torque).
-    first_partial: Option<Candidate>,
-    /// Where the first was held although its own trajectory refit disagreed with its screen
-    /// (the other's unmodelled part pulling that refit): its screen value and the half-width
-    /// the agreement allows ([`views_agree`]). In the model holding both, its refitted size
-    /// must then agree with that value.
-    first_screen: Option<(f64, f64)>,
-    /// Its held-out equation-error fall beside the second's column, and the bar it cleared.
-    first_eq_beside: (f64, f64),
-    /// Where the first was held although the validate runs' own rows put its size elsewhere
-    /// ([`sizes_disagree`]; the other's unmodelled part biasing those rows): its screening
-    /// and the value it was screened at. Beside the second (applied exactly where it is a
-    /// sensor's), the identify and validate rows must then put its size at one value.
-    first_sizes: Option<(Screened, f64)>,
-    /// The second candidate, judged beside the first.
-    second: Screened,
-    /// Where the second stood in the queue saved in `state` (it is taken out of it), so that
-    /// if the pair is not confirmed it is judged alone where it would have been.
-    second_at: Option<usize>,
-    /// The validation the first one's held-out gain was measured from (the model before the
-    /// pair): the pair together must take its bar off that E_θ.
-    before: Vec<RunFit>,
-    /// The search's state as the first one's refusal left it.
-    state: PairState,
-}
-
-/// The search's state that a provisional hold changes (see [`PairLook`]).
-type PairState = (
-    View,
-    Correction,
-    FitOutcome,
-    Vec<RunFit>,
-    Vec<usize>,
-    [Option<(Vec<f64>, Vec<RunFit>)>; 4],
-    usize,
-    std::collections::VecDeque<Screened>,
-    Vec<(String, DiagnosisRow)>,
-    Option<String>,
-);
 
 /// `x` (parameters of `spec`) with the reference model's damping terms (b, a, μ) set to the
 /// screen's joint estimate `fit` where it has them (finite, floored at 0).
@@ -5131,85 +4933,6 @@ pub fn discover(
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// The dry frictions' second look asks a replacement (the bearing load) whose column fits
-    /// the equation error as well as the one it replaces, to rounding, and not one that fits it
-    /// worse: where every identify window is free the two columns are one.
-    #[test]
-    fn the_second_look_asks_a_replacement_equal_to_its_column_to_rounding() {
-        let screened = |effect: &str, delta_bic: f64| Screened {
-            candidate: crate::screen::candidates(Base::Reference)
-                .into_iter()
-                .find(|c| c.effect == effect)
-                .unwrap(),
-            delta_bic,
-            fit: crate::screen::Ols {
-                columns: Vec::new(),
-                coef: Vec::new(),
-                se: Vec::new(),
-                rss: 1.0,
-                n: 10,
-                inertia_kg_m2: 0.0,
-            },
-        };
-        let asked = |delta_bic: f64| {
-            let first = [screened("bearing_load_base_accel", delta_bic)];
-            let mut look = SecondLook::NotStarted;
-            look.next(true, false, &first).is_some()
-        };
-        assert!(crate::screen::candidates(Base::Reference)
-            .iter()
-            .any(|c| c.effect == "bearing_load_base_accel" && c.replaces.is_some()));
-        assert!(asked(-3.0));
-        assert!(asked(0.0));
-        assert!(asked(7.105_427_357_601e-14));
-        assert!(!asked(0.5));
-    }
-
-    /// A reading joins a value by precision where the two agree: the more precise leads, the
-    /// joined interval is narrower than either, and a reading that disagrees leaves the value
-    /// alone. (The survey's pair 2 at seed 34: the equation error's 4.45e-2 [2.92e-2, 5.98e-2]
-    /// rad and eight free decays' centres 5.95e-2 ± 0.46e-2.)
-    #[test]
-    fn a_direct_reading_joins_a_value_by_precision_where_they_agree() {
-        let (v, lo, hi) =
-            joined_with_reading((4.45e-2, 2.92e-2, 5.98e-2), (5.95e-2, 0.46e-2), false)
-                .expect("they agree");
-        assert!(v > 5.7e-2 && v < 5.95e-2, "{v}");
-        assert!(hi - lo < 2.0 * 0.46e-2 && lo < v && v < hi);
-        // Equal precision: the midpoint.
-        let (m, ..) = joined_with_reading((1.0, 0.9, 1.1), (1.05, 0.1), false).unwrap();
-        assert!((m - 1.025).abs() < 1e-12);
-        // Apart beyond both intervals and 10 %: no join.
-        assert!(
-            joined_with_reading((4.45e-2, 4.3e-2, 4.6e-2), (5.95e-2, 0.46e-2), false).is_none()
-        );
-        // No interval to weigh: no join.
-        assert!(
-            joined_with_reading((4.45e-2, f64::NAN, 5.0e-2), (5.95e-2, 0.46e-2), false).is_none()
-        );
-        assert!(joined_with_reading((4.45e-2, 4.0e-2, 5.0e-2), (5.95e-2, 0.0), false).is_none());
-    }
-
-    /// A reading whose scatter the value shares (the free decays' centres and the equation
-    /// error both read the runs' zeros' mean): the joined value is still weighed by precision,
-    /// but its interval is no narrower than the reading's own, which alone measures how far
-    /// that mean may sit from the offset. (Drawn seed 7's offset: every run's equation error
-    /// about ±2.0 mrad, the centres ±1.18, joined as independent to ±1.02.)
-    #[test]
-    fn a_reading_whose_scatter_the_value_shares_keeps_its_own_interval() {
-        let value = (3.80e-2, 3.60e-2, 4.00e-2);
-        let reading = (3.84e-2, 0.118e-2);
-        let (vi, loi, hii) = joined_with_reading(value, reading, false).unwrap();
-        let (vs, los, his) = joined_with_reading(value, reading, true).unwrap();
-        // The same value either way: only the interval differs.
-        assert!((vi - vs).abs() < 1e-15);
-        assert!(0.5 * (hii - loi) < 0.99 * 0.118e-2, "{loi} {hii}");
-        assert!((0.5 * (his - los) - 0.118e-2).abs() < 1e-12, "{los} {his}");
-        // A reading far less precise than the value: the joined interval is the reading's width.
-        let (_, lo, hi) = joined_with_reading((1.0, 0.99, 1.01), (1.0, 0.5), true).unwrap();
-        assert!((0.5 * (hi - lo) - 0.5).abs() < 1e-12);
-    }
 
     /// A refinement whose steps shrink settles; one whose steps go on moving the value (a
     /// flat valley stepped across) is told apart, with the last step it took, so that its

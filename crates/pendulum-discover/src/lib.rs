@@ -7,6 +7,7 @@ pub mod discover;
 mod drift;
 pub mod envelope;
 mod heldout;
+mod looks;
 mod readings;
 mod residual;
 pub mod screen;

@@ -700,4 +700,49 @@ mod tests {
             row.note
         );
     }
+
+    /// A reading joins a value by precision where the two agree: the more precise leads, the
+    /// joined interval is narrower than either, and a reading that disagrees leaves the value
+    /// alone. (The survey's pair 2 at seed 34: the equation error's 4.45e-2 [2.92e-2, 5.98e-2]
+    /// rad and eight free decays' centres 5.95e-2 ± 0.46e-2.)
+    #[test]
+    fn a_direct_reading_joins_a_value_by_precision_where_they_agree() {
+        let (v, lo, hi) =
+            joined_with_reading((4.45e-2, 2.92e-2, 5.98e-2), (5.95e-2, 0.46e-2), false)
+                .expect("they agree");
+        assert!(v > 5.7e-2 && v < 5.95e-2, "{v}");
+        assert!(hi - lo < 2.0 * 0.46e-2 && lo < v && v < hi);
+        // Equal precision: the midpoint.
+        let (m, ..) = joined_with_reading((1.0, 0.9, 1.1), (1.05, 0.1), false).unwrap();
+        assert!((m - 1.025).abs() < 1e-12);
+        // Apart beyond both intervals and 10 %: no join.
+        assert!(
+            joined_with_reading((4.45e-2, 4.3e-2, 4.6e-2), (5.95e-2, 0.46e-2), false).is_none()
+        );
+        // No interval to weigh: no join.
+        assert!(
+            joined_with_reading((4.45e-2, f64::NAN, 5.0e-2), (5.95e-2, 0.46e-2), false).is_none()
+        );
+        assert!(joined_with_reading((4.45e-2, 4.0e-2, 5.0e-2), (5.95e-2, 0.0), false).is_none());
+    }
+
+    /// A reading whose scatter the value shares (the free decays' centres and the equation
+    /// error both read the runs' zeros' mean): the joined value is still weighed by precision,
+    /// but its interval is no narrower than the reading's own, which alone measures how far
+    /// that mean may sit from the offset. (Drawn seed 7's offset: every run's equation error
+    /// about ±2.0 mrad, the centres ±1.18, joined as independent to ±1.02.)
+    #[test]
+    fn a_reading_whose_scatter_the_value_shares_keeps_its_own_interval() {
+        let value = (3.80e-2, 3.60e-2, 4.00e-2);
+        let reading = (3.84e-2, 0.118e-2);
+        let (vi, loi, hii) = joined_with_reading(value, reading, false).unwrap();
+        let (vs, los, his) = joined_with_reading(value, reading, true).unwrap();
+        // The same value either way: only the interval differs.
+        assert!((vi - vs).abs() < 1e-15);
+        assert!(0.5 * (hii - loi) < 0.99 * 0.118e-2, "{loi} {hii}");
+        assert!((0.5 * (his - los) - 0.118e-2).abs() < 1e-12, "{los} {his}");
+        // A reading far less precise than the value: the joined interval is the reading's width.
+        let (_, lo, hi) = joined_with_reading((1.0, 0.99, 1.01), (1.0, 0.5), true).unwrap();
+        assert!((0.5 * (hi - lo) - 0.5).abs() < 1e-12);
+    }
 }
