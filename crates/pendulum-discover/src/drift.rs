@@ -7,7 +7,8 @@ use pendulum_process::identify::{validate, FitOutcome, RunFit};
 use pendulum_process::pipeline::Context;
 use pendulum_process::{ProcessError, Role};
 
-use crate::discover::{views_agree, DiagnosisRow, DiscoverConfig};
+use crate::agreement::views_agree;
+use crate::discover::{DiagnosisRow, DiscoverConfig};
 use crate::heldout::{e_total, heldout_gain};
 use crate::readings::{per_run_mean, pool_readings, sensor_heldout, SENSOR_HELDOUT_GAIN};
 use crate::trajectories::{

@@ -2,6 +2,7 @@
 //! the catalogue effect responsible (or say `unexplained`), extend the model, and measure the
 //! gain on runs the fit never saw.
 
+mod agreement;
 pub mod damping;
 pub mod discover;
 mod drift;

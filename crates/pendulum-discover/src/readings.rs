@@ -8,7 +8,8 @@ use pendulum_process::identify::{validate, FitOutcome, RunFit};
 use pendulum_process::pipeline::Context;
 use pendulum_process::{ProcessError, Role};
 
-use crate::discover::{judged_for, sizes_disagree, views_agree, DiagnosisRow, DiscoverConfig};
+use crate::agreement::{sizes_disagree, views_agree};
+use crate::discover::{judged_for, DiagnosisRow, DiscoverConfig};
 use crate::heldout::{e_total, heldout_gain};
 use crate::trajectories::{
     followed_ics, moving_runs, refit, refit_profile, substitution_segments,
