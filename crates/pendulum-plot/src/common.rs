@@ -288,9 +288,8 @@ pub fn finite_range(values: impl IntoIterator<Item = f64>) -> Option<(f64, f64)>
 
 /// A fixed y range no narrower than `min_span` for `values` (their finite ones) that span less,
 /// centred on them; `None` where they span at least that (fit the data as usual) or hold nothing
-/// finite. Fitted to the data, a trace that hardly moves is magnified to its rounding: a
-/// resting pendulum's measured and simulated angles, 1.4e-7 rad apart, filled the panel as two
-/// lines far apart.
+/// finite. Fitted to the data, a trace that hardly moves is magnified to its rounding: two flat
+/// series 1.4e-7 apart filled a panel as two lines far apart.
 pub fn floor_span(values: impl IntoIterator<Item = f64>, min_span: f64) -> Option<(f64, f64)> {
     let (lo, hi) = finite_range(values)?;
     let mid = 0.5 * (lo + hi);
