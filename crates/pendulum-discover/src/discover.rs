@@ -4264,23 +4264,12 @@ pub fn discover(
             String::new()
         };
         rows.push(DiagnosisRow {
-            effect: sc.candidate.effect.clone(),
-            accepted: false,
             estimate: value,
             identify_estimate: value,
             ci_low,
             ci_high,
-            unit: unit.into(),
             delta_bic: sc.delta_bic,
-            heldout_gain: f64::NAN,
-            heldout_noise: f64::NAN,
-            heldout_eq_gain: f64::NAN,
             screen_estimate: est,
-        refit_estimate: f64::NAN,
-        refit_ci_low: f64::NAN,
-        refit_ci_high: f64::NAN,
-            e_validate_before: f64::NAN,
-            e_validate_after: f64::NAN,
             note: if let Some((a, b)) = range {
                 format!(
                     "{k_words}not estimable on the identify runs: the screen's 95 % interval, [{:.4e}, {:.4e}] {unit} about {est:.4e}, is wider than the effect's whole range [{a:.4e}, {b:.4e}] (its column hardly moves on their windows: too few where the pendulum moves under the shaker); neither found nor ruled out",
@@ -4302,6 +4291,7 @@ pub fn discover(
             } else {
                 "screened out".into()
             },
+            ..DiagnosisRow::words_only(&sc.candidate.effect, unit, String::new())
         });
     }
 

@@ -125,24 +125,17 @@ pub(crate) fn speed_drift_row(
 ) -> Result<(DiagnosisRow, Option<DriftModel>), ProcessError> {
     let (n, est, half) = (ev.n, ev.est, ev.half);
     let mut row = DiagnosisRow {
-        effect: "speed_drift".into(),
-        accepted: false,
         estimate: est,
         identify_estimate: est,
         ci_low: est - half,
         ci_high: est + half,
-        unit: "Hz/s".into(),
         delta_bic: ev.delta_bic,
-        heldout_gain: f64::NAN,
-        heldout_noise: f64::NAN,
-        heldout_eq_gain: f64::NAN,
         screen_estimate: est,
-        refit_estimate: f64::NAN,
-        refit_ci_low: f64::NAN,
-        refit_ci_high: f64::NAN,
-        e_validate_before: f64::NAN,
-        e_validate_after: f64::NAN,
-        note: format!("crank fits with a drifting speed on {n} identify runs; screened out"),
+        ..DiagnosisRow::words_only(
+            "speed_drift",
+            "Hz/s",
+            format!("crank fits with a drifting speed on {n} identify runs; screened out"),
+        )
     };
     let Some(ctx2) = ctx2.filter(|_| ev.significant && !base_fit.spec.params.is_empty()) else {
         return Ok((row, None));

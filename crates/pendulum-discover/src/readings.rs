@@ -219,21 +219,14 @@ pub(crate) fn accel_gain_row(ctx: &Context, cfg: &DiscoverConfig) -> Option<Diag
         && delta_bic < cfg.screen_threshold
         && gain > SENSOR_HELDOUT_GAIN;
     let mut row = DiagnosisRow {
-        effect: "accel_gain".into(),
         accepted,
         estimate: est,
         identify_estimate: est,
         ci_low: est - half,
         ci_high: est + half,
-        unit: "1".into(),
         delta_bic,
         heldout_gain: gain,
-        heldout_noise: f64::NAN,
-        heldout_eq_gain: f64::NAN,
         screen_estimate: est,
-        refit_estimate: f64::NAN,
-        refit_ci_low: f64::NAN,
-        refit_ci_high: f64::NAN,
         e_validate_before: before,
         e_validate_after: after,
         note: format!(
@@ -248,6 +241,7 @@ pub(crate) fn accel_gain_row(ctx: &Context, cfg: &DiscoverConfig) -> Option<Diag
                 ": below it"
             }
         ),
+        ..DiagnosisRow::words_only("accel_gain", "1", String::new())
     };
     pool_readings(&mut row, &g_id, &g_val, 1.0);
     Some(row)
