@@ -70,7 +70,7 @@ pub(crate) fn trajectory_substitution(
 /// error then measures only how the restarts' rate estimates (from quantised angles) set it
 /// sliding, which favours more friction: on a drawn design (issue 12 survey, viscous drag hidden
 /// from the dry base) such a run alone pulled the refit of b from 0.48 to 0.
-pub const STILL_SPAN_STEPS: f64 = 10.0;
+pub(crate) const STILL_SPAN_STEPS: f64 = 10.0;
 
 /// The model in hand once a candidate's model (`spec`, parameters `x`) is taken: `current` with
 /// them, its objective and per-run fits evaluated on the identify runs from their initial states
