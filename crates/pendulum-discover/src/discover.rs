@@ -53,7 +53,7 @@ use crate::readings::{
     accel_gain_row, hanging_interval, hangs_as_an_offset, horizontal_slopes, joined_with_reading,
     per_run_mean, sensor_heldout, t95, tilt_reading, zeroing_half, TiltJudge, SENSOR_HELDOUT_GAIN,
 };
-use crate::residual::{anova, bin_means_heldout, RESIDUAL_VARIABLES};
+use crate::residual::{strongest_variable, worst_confirmed_variable};
 use crate::screen::{ols, stepwise, stepwise_from, with_candidate, Base, Candidate, Screened};
 use crate::trajectories::{
     followed_ics, is_moving, moving_runs, pooled_refit, refit, refit_objective, refit_profile,
@@ -4352,15 +4352,6 @@ pub fn discover(
     let final_res = final_ols.residuals(&view.weak);
     let residual_final = view.matched_to(&view0, &final_res, cfg.weak.half_width_s);
     let id_mask = view.identify_mask();
-    let pick = |f: &dyn Fn(&WeakRow) -> f64| -> (Vec<f64>, Vec<f64>) {
-        view.weak
-            .iter()
-            .zip(&final_res)
-            .zip(&id_mask)
-            .filter(|(_, m)| **m)
-            .map(|((r, e), _)| (f(r), *e))
-            .unzip()
-    };
     // Rows the bin means were not taken from judge it ([`bin_means_heldout`]), as the validate
     // runs judge a catalogue effect and the generic description below: on identify rows alone, thousands of windows whose noise grows with
     // |θ̇| make a one-way F beyond p < 1e-6 out of a fit that is right. Nothing hidden on drawn
@@ -4372,19 +4363,8 @@ pub fn discover(
         .iter()
         .map(|r| view.weak_runs[r.run].1 == Role::Validate)
         .collect();
-    let mut worst: Option<(String, f64, f64, (f64, f64))> = None;
-    for (name, f) in &RESIDUAL_VARIABLES[..3] {
-        let (k, e) = pick(f);
-        if let Some((fstat, p)) = anova(&k, &e, 12) {
-            if p < 1e-6 && worst.as_ref().is_none_or(|w| fstat > w.1) {
-                let key: Vec<f64> = view.weak.iter().map(f).collect();
-                let held = bin_means_heldout(&view.weak, &key, &final_res, &id_mask, &val_mask, 12);
-                if let Some(held) = held.filter(|&(g, n)| g > cfg.eq_gain_min.max(n)) {
-                    worst = Some((name.to_string(), fstat, p, held));
-                }
-            }
-        }
-    }
+    let worst =
+        worst_confirmed_variable(&view.weak, &final_res, &id_mask, &val_mask, cfg.eq_gain_min);
     // A generic sparse description of what remains, judged on the validate rows like a
     // catalogue effect; the catalogue model's own columns are refitted along with it.
     let description = view.describe(
@@ -4525,25 +4505,11 @@ pub fn discover(
                     not_followed_runs.iter().any(|(r, _)| *r == id)
                 })
                 .collect();
-            let bins = (rows_of.len() / 10).min(12);
-            if bins < 3 {
-                return None;
-            }
-            let e: Vec<f64> = rows_of.iter().map(|&i| final_res[i]).collect();
-            let mut best: Option<(&str, f64, f64)> = None;
-            for (name, f) in RESIDUAL_VARIABLES {
-                let k: Vec<f64> = rows_of.iter().map(|&i| f(&view.weak[i])).collect();
-                if let Some((fstat, p)) = anova(&k, &e, bins) {
-                    if p < 1e-6 && best.is_none_or(|b| fstat > b.1) {
-                        best = Some((name, fstat, p));
-                    }
-                }
-            }
-            best.map(|(name, f, p)| {
-                format!(
-                    "; in those runs the remaining equation error varies with {name} (F = {f:.1}, p = {p:.1e} over {bins} bins)"
-                )
-            })
+            let (name, f, p, bins) =
+                strongest_variable(&view.weak, &final_res, &rows_of)?;
+            Some(format!(
+                "; in those runs the remaining equation error varies with {name} (F = {f:.1}, p = {p:.1e} over {bins} bins)"
+            ))
         })
         .flatten()
         .unwrap_or_default();
@@ -4633,6 +4599,7 @@ pub fn discover(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::residual::{anova, bin_means_heldout};
 
     /// A refinement whose steps shrink settles; one whose steps go on moving the value (a
     /// flat valley stepped across) is told apart, with the last step it took, so that its

@@ -139,3 +139,65 @@ pub(crate) fn bin_means_heldout(
     }
     (!before.is_empty()).then(|| paired_gain(&before, &after))
 }
+
+/// The variable (of the first three of [`RESIDUAL_VARIABLES`]: θ̇, θ, the forcing phase) the
+/// identify rows' remaining equation error `res` varies with most, by a one-way F over 12 bins
+/// with p < 1e-6, among those whose bin means rows they were not taken from confirm
+/// ([`bin_means_heldout`]: the validate rows', and each identify run's from the others' means,
+/// by more than max(`eq_gain_min`, its noise)): its name, F, p and that held-out (fall, noise).
+pub(crate) fn worst_confirmed_variable(
+    weak: &[WeakRow],
+    res: &[f64],
+    id_mask: &[bool],
+    val_mask: &[bool],
+    eq_gain_min: f64,
+) -> Option<(String, f64, f64, (f64, f64))> {
+    let pick = |f: &dyn Fn(&WeakRow) -> f64| -> (Vec<f64>, Vec<f64>) {
+        weak.iter()
+            .zip(res)
+            .zip(id_mask)
+            .filter(|(_, m)| **m)
+            .map(|((r, e), _)| (f(r), *e))
+            .unzip()
+    };
+    let mut worst: Option<(String, f64, f64, (f64, f64))> = None;
+    for (name, f) in &RESIDUAL_VARIABLES[..3] {
+        let (k, e) = pick(f);
+        if let Some((fstat, p)) = anova(&k, &e, 12) {
+            if p < 1e-6 && worst.as_ref().is_none_or(|w| fstat > w.1) {
+                let key: Vec<f64> = weak.iter().map(f).collect();
+                let held = bin_means_heldout(weak, &key, res, id_mask, val_mask, 12);
+                if let Some(held) = held.filter(|&(g, n)| g > eq_gain_min.max(n)) {
+                    worst = Some((name.to_string(), fstat, p, held));
+                }
+            }
+        }
+    }
+    worst
+}
+
+/// The variable of [`RESIDUAL_VARIABLES`] the remaining equation error `res` of the rows `rows`
+/// varies with most, by a one-way F with p < 1e-6 over up to 12 bins (a tenth of the rows, at
+/// least 3): its name, F, p and the bins. For a few runs' rows, which give fewer rows than a
+/// campaign's 12-bin view needs.
+pub(crate) fn strongest_variable(
+    weak: &[WeakRow],
+    res: &[f64],
+    rows: &[usize],
+) -> Option<(&'static str, f64, f64, usize)> {
+    let bins = (rows.len() / 10).min(12);
+    if bins < 3 {
+        return None;
+    }
+    let e: Vec<f64> = rows.iter().map(|&i| res[i]).collect();
+    let mut best: Option<(&str, f64, f64)> = None;
+    for (name, f) in RESIDUAL_VARIABLES {
+        let k: Vec<f64> = rows.iter().map(|&i| f(&weak[i])).collect();
+        if let Some((fstat, p)) = anova(&k, &e, bins) {
+            if p < 1e-6 && best.is_none_or(|b| fstat > b.1) {
+                best = Some((name, fstat, p));
+            }
+        }
+    }
+    best.map(|(name, f, p)| (name, f, p, bins))
+}
