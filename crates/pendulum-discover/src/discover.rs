@@ -53,13 +53,13 @@ use crate::readings::{
     accel_gain_row, hanging_interval, hangs_as_an_offset, horizontal_slopes, joined_with_reading,
     per_run_mean, sensor_heldout, t95, tilt_reading, zeroing_half, TiltJudge, SENSOR_HELDOUT_GAIN,
 };
-use crate::residual::{strongest_variable, worst_confirmed_variable};
 use crate::screen::{ols, stepwise, stepwise_from, with_candidate, Base, Candidate, Screened};
 use crate::trajectories::{
     followed_ics, is_moving, moving_runs, pooled_refit, refit, refit_objective, refit_profile,
     refit_zeroed_on, sets_sticking_capacity, shape_start, substitution_segments, taken,
     trajectory_range, trajectory_substitution, with_run_zeros, without_still_tail,
 };
+use crate::unexplained::{cut_short, Remaining};
 use crate::weak::{weak_rows, WeakConfig, WeakRow};
 
 /// Discovery settings.
@@ -4347,24 +4347,18 @@ pub fn discover(
         ));
     }
 
-    // What stays unexplained, and where.
+    // What stays unexplained, and where ([`crate::unexplained`]).
     let final_ols = ols(&view.id_rows, &current_cols).unwrap_or(base_ols.clone());
     let final_res = final_ols.residuals(&view.weak);
     let residual_final = view.matched_to(&view0, &final_res, cfg.weak.half_width_s);
     let id_mask = view.identify_mask();
-    // Rows the bin means were not taken from judge it ([`bin_means_heldout`]), as the validate
-    // runs judge a catalogue effect and the generic description below: on identify rows alone, thousands of windows whose noise grows with
-    // |θ̇| make a one-way F beyond p < 1e-6 out of a fit that is right. Nothing hidden on drawn
-    // designs whose validate runs rest or tumble, the base's damping within 5 % of the truth,
-    // gave "varies with dθ/dt" at F = 6.0 (`SURVEY_DAMPING=drawn SURVEY_SEED=33`, campaign 40;
-    // seed 30's campaign 17 and seed 32's campaign 28 alike).
-    let val_mask: Vec<bool> = view
-        .weak
-        .iter()
-        .map(|r| view.weak_runs[r.run].1 == Role::Validate)
-        .collect();
-    let worst =
-        worst_confirmed_variable(&view.weak, &final_res, &id_mask, &val_mask, cfg.eq_gain_min);
+    let remaining = Remaining {
+        weak: &view.weak,
+        weak_runs: &view.weak_runs,
+        res: &final_res,
+        id_mask: &id_mask,
+        eq_gain_min: cfg.eq_gain_min,
+    };
     // A generic sparse description of what remains, judged on the validate rows like a
     // catalogue effect; the catalogue model's own columns are refitted along with it.
     let description = view.describe(
@@ -4373,52 +4367,6 @@ pub fn discover(
         final_ols.inertia_kg_m2,
         cfg.eq_gain_min,
     );
-    let confirmed_description = description
-        .as_ref()
-        .filter(|d| d.heldout_gain > cfg.eq_gain_min.max(d.heldout_noise));
-    // The description the words below use, if any.
-    let described = match (confirmed_description, &description) {
-        (Some(d), _) => Some(d.clone()),
-        (None, Some(d)) if refused.is_some() => Some(d.clone()),
-        _ => None,
-    };
-    // A description that is a catalogue entry's own shape says so: the entry was tried and not
-    // named (a 3.4e-3 N·m constant dry torque whose trajectory refit said 1.9e-3 was described as
-    // "a step at dθ/dt = 0" of 3.3e-3 N·m, which reads as a departure outside the catalogue).
-    let twin_words = |d: &crate::sparse::Description| -> String {
-        let twin = d.catalogue_twin().and_then(|e| {
-            rows.iter()
-                .find(|r| r.effect == e && !r.accepted && r.screen_estimate.is_finite())
-        });
-        match twin {
-            Some(r) => format!(
-                "{}; this is the shape of the catalogue's `{}`, tried and not named (screen {:.3e} {}, trajectory refit {:.3e}; its row says why)",
-                d.words(&|r| view.weak_runs[r].0.clone()),
-                r.effect,
-                r.screen_estimate,
-                r.unit,
-                r.refit_estimate
-            ),
-            None => d.words(&|r| view.weak_runs[r].0.clone()),
-        }
-    };
-    let structure = match (confirmed_description, &description) {
-        (Some(d), _) => Some(twin_words(d)),
-        // A refused candidate already says a departure is there; describe it even where the
-        // validate runs cannot confirm the description's shape, and say so.
-        (None, Some(d)) if refused.is_some() => Some(format!(
-            "{} (the validate runs do not confirm this shape)",
-            d.words(&|r| view.weak_runs[r].0.clone())
-        )),
-        _ => worst.map(|(name, f, p, (g, n))| {
-            format!(
-                "the remaining equation error varies with {name} (F = {f:.1}, p = {p:.1e} over 12 bins of the identify runs' rows; on rows they were not taken from, the validate runs' and each identify run's beside the others', their bin means take {:.1} % ± {:.1} % off the equation error)",
-                100.0 * g,
-                100.0 * n
-            )
-        }),
-    };
-    // Whether the runs disagree on the model's own terms (the variable "the run").
     let spread = {
         let pooled: Vec<f64> = current_cols
             .iter()
@@ -4433,112 +4381,36 @@ pub fn discover(
             &id_mask,
         )
     };
-    let structure = match (
-        structure,
-        spread
-            .as_ref()
-            .filter(|sp| sp.confirmed(cfg.eq_gain_min))
-            .map(|sp| sp.words(&|r| view.weak_runs[r].0.clone())),
-    ) {
-        (Some(a), Some(b)) => Some(format!("{a}; {b}")),
-        (a, b) => a.or(b),
-    };
-    // Nothing named and the model in hand pinned at its own search range: it does not follow
-    // these runs, and saying nothing would read as "nothing there" (an encoder counting 8192 a
-    // turn under a 4096 header put μ at its bound 0.25, and discover said nothing).
-    // Not where the free swings undo the pin: they reject the base's damping and one damping
-    // inside the range follows them and the forced windows both (`DampingVerdict::NotPinned`,
-    // reported on its own), so the bound says only that the forced windows left the split among
-    // the terms open. Nothing hidden on a drawn design whose identify runs all rest under their
-    // shaking (`SURVEY_DAMPING=drawn SURVEY_SEED=33`, campaign 7) put μ at 0.2499 for a rig of
-    // 0.189 and said the model did not follow the runs; the joint damping was μ 0.202, b 0.488
-    // (truth 0.514), a 0.029.
+    let (structure, described) = remaining.structure(description, spread, &rows, refused.is_some());
+    // The model in hand's failures, where nothing was named. Its fit pinned at its own search
+    // range, but not where the free swings undo the pin: they reject the base's damping and one
+    // damping inside the range follows them and the forced windows both
+    // (`DampingVerdict::NotPinned`, reported on its own), so the bound says only that the forced
+    // windows left the split among the terms open. Nothing hidden on a drawn design whose
+    // identify runs all rest under their shaking (`SURVEY_DAMPING=drawn SURVEY_SEED=33`,
+    // campaign 7) put μ at 0.2499 for a rig of 0.189 and said the model did not follow the
+    // runs; the joint damping was μ 0.202, b 0.488 (truth 0.514), a 0.029.
+    let nothing_named = current.spec == base_fit.spec;
     let pin_undone = damping_check.as_ref().is_some_and(|dc| {
         dc.verdict() == DampingVerdict::NotPinned
             && pins(&base_fit.spec, &dc.joint_params).is_empty()
     });
-    let cut_short: Vec<String> = if current.spec == base_fit.spec && !pin_undone {
-        pendulum_process::identify::bound_hits(&id_runs, &base_fit)
-            .iter()
-            .filter(|h| !h.unused())
-            .map(|h| {
-                format!(
-                    "{} = {:.4e} at its {} bound {:.4}",
-                    h.name, h.value, h.side, h.bound
-                )
-            })
-            .collect()
-    } else {
-        Vec::new()
-    };
-    // Runs the model in hand does not follow at all: its predictions from the measured state
-    // miss by half or more of how far the angle moves (an encoder counting twice a turn: E_θ
-    // of 996, 1468 and 3011 on chaotic runs where a fitting model leaves a few units).
-    let not_followed_runs: Vec<(&str, f64)> = if current.spec == base_fit.spec {
-        base_fit
-            .runs
-            .iter()
-            .chain(&v1)
-            .filter_map(|f| {
-                let run = id_runs.iter().chain(&val_runs).find(|r| r.id == f.id)?;
-                let ratio = pendulum_process::identify::misfit_ratio(run, f.e_theta)?;
-                (ratio >= MISFIT_RATIO).then_some((f.id.as_str(), ratio))
-            })
-            .collect()
-    } else {
-        Vec::new()
-    };
-    let not_followed: Vec<String> = not_followed_runs
-        .iter()
-        .map(|(id, ratio)| format!("{id} ({:.0} %)", 100.0 * ratio))
-        .collect();
-    // Where those runs' departure lives: the variable their own rows' remaining equation error
-    // varies with most (validate runs' rows too; a few runs give fewer rows than the campaign's
-    // 12-bin view needs). An encoder counting 7 % under its header left one chaotic validate run
-    // unfollowed, its rows' error varying with θ (mod 2π) at F = 8.5 over 11 bins (p 8e-10)
-    // while the identify runs, swinging gently, showed nothing.
-    let not_followed_variable = (!not_followed_runs.is_empty())
+    let fit_cut_short = (nothing_named && !pin_undone)
+        .then(|| cut_short(&id_runs, &base_fit))
+        .flatten();
+    let not_followed = nothing_named
         .then(|| {
-            let rows_of: Vec<usize> = (0..view.weak.len())
-                .filter(|&i| {
-                    let id = view.weak_runs[view.weak[i].run].0.as_str();
-                    not_followed_runs.iter().any(|(r, _)| *r == id)
-                })
-                .collect();
-            let (name, f, p, bins) =
-                strongest_variable(&view.weak, &final_res, &rows_of)?;
-            Some(format!(
-                "; in those runs the remaining equation error varies with {name} (F = {f:.1}, p = {p:.1e} over {bins} bins)"
-            ))
+            let runs: Vec<&PreparedRun> = id_runs.iter().chain(&val_runs).collect();
+            remaining.not_followed(base_fit.runs.iter().chain(&v1), &runs)
         })
+        .flatten();
+    // Why the best candidate was refused, then each failure of the model in hand, then the
+    // structure.
+    let parts: Vec<String> = [refused, fit_cut_short, not_followed, structure]
+        .into_iter()
         .flatten()
-        .unwrap_or_default();
-    // Each failure of the model in hand, when there is one, leads the words.
-    let lead = |structure: Option<String>, items: &[String], words: &dyn Fn(String) -> String| {
-        if items.is_empty() {
-            return structure;
-        }
-        let w = words(items.join(", "));
-        Some(match structure {
-            Some(s) => format!("{w}; {s}"),
-            None => w,
-        })
-    };
-    let structure = lead(structure, &not_followed, &|runs| {
-        format!(
-            "the model in hand does not follow runs {runs}: restarted from the measured state, its predictions miss by that share of how far the angle moves (a departure far beyond a small correction: the angle's scale, the rig's geometry){not_followed_variable}"
-        )
-    });
-    let structure = lead(structure, &cut_short, &|hits| {
-        format!(
-            "the base model's own fit is cut short by its search range ({hits}): the model in hand does not follow these runs (a departure it lacks, or damping beyond the range)"
-        )
-    });
-    let unexplained = match (refused, structure) {
-        (Some(r), Some(s)) => Some(format!("{r}; {s}")),
-        (Some(r), None) => Some(r),
-        (None, s) => s,
-    };
+        .collect();
+    let unexplained = (!parts.is_empty()).then(|| parts.join("; "));
     if let Some(w) = &unexplained {
         rows.push(DiagnosisRow::words_only("unexplained", "-", w.clone()));
     }

@@ -14,6 +14,7 @@ mod residual;
 pub mod screen;
 pub mod sparse;
 mod trajectories;
+mod unexplained;
 pub mod weak;
 
 pub use damping::{DampingCheck, DampingVerdict};
