@@ -11,6 +11,7 @@ mod maps;
 mod real;
 mod real_decays;
 mod shard;
+mod suite;
 mod twin_decays;
 mod unexplained;
 mod util;

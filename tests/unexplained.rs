@@ -307,7 +307,7 @@ fn friction_that_differs_from_run_to_run_names_nothing() {
 /// `unexplained` following θ (unwrapped), "linear in the unwrapped θ (a spring), cubic", the
 /// linear term 0.17 N·m/rad; one refused `extra_inertia` as impossible (−2.1e-3 kg·m²).
 #[test]
-#[ignore = "slow set (two drawn cables, 66 s on 2 cores beside another test; the departure survey draws five): the default suite checks that a cable is not named and that the words follow θ (unwrapped) on a_cable_anchored_off_the_vertical_is_not_named_an_encoder_offset, and a spring on regression_issue_14_torsion_spring_is_unexplained; README, Tests"]
+#[ignore = "slow set (two drawn cables, 66 s on 2 cores beside another test; the departure survey draws five): the default suite checks that a cable is not named and that the words follow θ (unwrapped) on a_cable_whose_rest_an_offset_takes_up_is_not_named_one_beside_the_spring_left, and a spring on regression_issue_14_torsion_spring_is_unexplained; README, Tests"]
 fn slack_cable_is_unexplained_and_follows_the_angle() {
     let mut r = rng(6);
     for case in 0..2 {
@@ -453,7 +453,7 @@ fn a_bouncing_bob_whose_lag_makes_the_held_out_runs_worse_is_not_named() {
 /// judged it, and one view's bare pass is not two views agreeing: nothing may be named, and the
 /// lag's row says why.
 #[test]
-#[ignore = "slow set (one kept draw, 25 s on 2 cores): the default suite checks the lone view's margin on a_lag_the_validate_runs_e_theta_cannot_see_is_judged_on_their_equation_error (a true lag through it) and a growing friction on regression_issue_12_growing_dry_torque_is_unexplained; docs/discovery.md, An input effect the validate runs' E_θ cannot see"]
+#[ignore = "slow set (one kept draw, 25 s on 2 cores): the default suite checks the lone view's margin on a_lag_the_validate_runs_e_theta_cannot_see_is_judged_on_their_equation_error (a true lag through it) and a growing friction on a_fast_growing_dry_torque_is_not_named_a_constant_one; docs/discovery.md, An input effect the validate runs' E_θ cannot see"]
 fn a_growing_friction_is_not_named_a_lag_on_one_views_bare_pass() {
     let (seed, b, mu, departure) = drawn_departure("dry_torque_growth", 0, 500_000);
     let s = discover_with(seed, b, mu, &departure);
