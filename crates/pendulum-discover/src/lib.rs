@@ -19,4 +19,5 @@ pub mod weak;
 
 pub use damping::{DampingCheck, DampingVerdict};
 pub use discover::{discover, DiagnosisRow, DiscoverConfig, Discovery};
+pub use residual::campaign_variables;
 pub use screen::Base;

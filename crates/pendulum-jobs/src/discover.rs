@@ -1220,7 +1220,13 @@ fn write_report(
             let _ = writeln!(r, "**Unexplained:** {u}.\n");
         }
         None => {
-            let _ = writeln!(r, "No structure is left in the equation error against dθ/dt, θ or the forcing phase that rows the fit did not see confirm (a one-way F on the identify runs' rows with p < 1e-6, whose bin means take more than max(5 %, its noise) off the equation error of the validate runs' rows and of each identify run's from the others' means), and the generic description finds none the validate runs confirm.\n");
+            // The variables as the analysis bins them.
+            let v = pendulum_discover::campaign_variables();
+            let variables = match v.split_last() {
+                Some((last, rest)) if !rest.is_empty() => format!("{} or {last}", rest.join(", ")),
+                _ => v.join(""),
+            };
+            let _ = writeln!(r, "No structure is left in the equation error against {variables} that rows the fit did not see confirm (a one-way F on the identify runs' rows with p < 1e-6, whose bin means take more than max(5 %, its noise) off the equation error of the validate runs' rows and of each identify run's from the others' means), and the generic description finds none the validate runs confirm.\n");
         }
     }
     if let Some(ext) = &d.extended {
