@@ -4382,7 +4382,7 @@ pub fn discover(
         )
     };
     let (structure, described) = remaining.structure(description, spread, &rows, refused.is_some());
-    // The model in hand's failures, where nothing was named. Its fit pinned at its own search
+    // The model in hand's failures, where it is still the base fit. Its fit pinned at its own search
     // range, but not where the free swings undo the pin: they reject the base's damping and one
     // damping inside the range follows them and the forced windows both
     // (`DampingVerdict::NotPinned`, reported on its own), so the bound says only that the forced
@@ -4390,15 +4390,15 @@ pub fn discover(
     // identify runs all rest under their shaking (`SURVEY_DAMPING=drawn SURVEY_SEED=33`,
     // campaign 7) put μ at 0.2499 for a rig of 0.189 and said the model did not follow the
     // runs; the joint damping was μ 0.202, b 0.488 (truth 0.514), a 0.029.
-    let nothing_named = current.spec == base_fit.spec;
+    let model_is_base = current.spec == base_fit.spec;
     let pin_undone = damping_check.as_ref().is_some_and(|dc| {
         dc.verdict() == DampingVerdict::NotPinned
             && pins(&base_fit.spec, &dc.joint_params).is_empty()
     });
-    let fit_cut_short = (nothing_named && !pin_undone)
+    let fit_cut_short = (model_is_base && !pin_undone)
         .then(|| cut_short(&id_runs, &base_fit))
         .flatten();
-    let not_followed = nothing_named
+    let not_followed = model_is_base
         .then(|| {
             let runs: Vec<&PreparedRun> = id_runs.iter().chain(&val_runs).collect();
             remaining.not_followed(base_fit.runs.iter().chain(&v1), &runs)
