@@ -10,7 +10,7 @@ use pendulum_process::{ProcessError, Role};
 use crate::agreement::views_agree;
 use crate::discover::{DiagnosisRow, DiscoverConfig};
 use crate::heldout::{e_total, heldout_gain};
-use crate::readings::{per_run_mean, pool_readings, sensor_heldout, SENSOR_HELDOUT_GAIN};
+use crate::readings::{per_role, per_run_mean, pool_readings, sensor_heldout, SENSOR_HELDOUT_GAIN};
 use crate::trajectories::{
     is_moving, moving_runs, refit_objective, refit_profile, refit_zeroed_on, substitution_segments,
     trajectory_substitution,
@@ -48,15 +48,7 @@ pub(crate) fn drift_evidence(ctx: &Context, cfg: &DiscoverConfig) -> Option<Drif
             fits.insert(run.id.clone(), f);
         }
     }
-    let drifts = |role: Role| -> Vec<f64> {
-        ctx.runs
-            .iter()
-            .filter(|r| r.role == role)
-            .filter_map(|r| fits.get(&r.id))
-            .map(|f| f.drift_hz_per_s)
-            .collect()
-    };
-    let (d_id, val) = (drifts(Role::Identify), drifts(Role::Validate));
+    let (d_id, val) = per_role(ctx, |r| fits.get(&r.id).map(|f| f.drift_hz_per_s));
     let n = d_id.len();
     if n < 3 {
         return None;

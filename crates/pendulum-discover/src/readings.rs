@@ -30,6 +30,22 @@ pub(crate) fn t95(df: usize) -> f64 {
     }
 }
 
+/// A per-run reading (`value`, where a run has one) of the identify runs and of the validate
+/// runs, each in the campaign's run order: the sensor effects' two sets of readings.
+pub(crate) fn per_role(
+    ctx: &Context,
+    value: impl Fn(&pendulum_process::run::RunData) -> Option<f64>,
+) -> (Vec<f64>, Vec<f64>) {
+    let of = |role: Role| -> Vec<f64> {
+        ctx.runs
+            .iter()
+            .filter(|r| r.role == role)
+            .filter_map(&value)
+            .collect()
+    };
+    (of(Role::Identify), of(Role::Validate))
+}
+
 /// A quantity measured once per run (n ≥ 2): its mean, the half-width of the mean's 95 %
 /// interval from the runs' scatter (Student's t), and ΔBIC of "mean" against `nominal`.
 pub(crate) fn per_run_mean(values: &[f64], nominal: f64) -> (f64, f64, f64) {
@@ -196,16 +212,12 @@ pub(crate) const SENSOR_HELDOUT_GAIN: f64 = 0.5;
 /// |k_a| exceeds [`ACCEL_GAIN_FLOOR`], ΔBIC (over the runs' G) beats the screen threshold and the
 /// held-out gain is above one half.
 pub(crate) fn accel_gain_row(ctx: &Context, cfg: &DiscoverConfig) -> Option<DiagnosisRow> {
-    let gains = |role: Role| -> Vec<f64> {
-        ctx.runs
-            .iter()
-            .filter(|r| r.role == role)
-            .filter_map(|r| ctx.alignments.get(&r.id))
+    let (g_id, g_val) = per_role(ctx, |r| {
+        ctx.alignments
+            .get(&r.id)
             .filter(|a| !a.is_free() && a.accel_gain.is_finite() && a.forcing_understood())
             .map(|a| a.accel_gain)
-            .collect()
-    };
-    let (g_id, g_val) = (gains(Role::Identify), gains(Role::Validate));
+    });
     let n = g_id.len();
     if n < 3 {
         return None;
