@@ -221,22 +221,13 @@ pub(crate) fn strongest_variable(
 mod tests {
     use super::*;
     use crate::weak::test_row;
-
-    /// A deterministic noise in [−1, 1) (splitmix64 of the index).
-    fn noise(i: usize) -> f64 {
-        let mut z = (i as u64)
-            .wrapping_add(1)
-            .wrapping_mul(0x9E37_79B9_7F4A_7C15);
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^= z >> 31;
-        (z >> 11) as f64 / (1u64 << 52) as f64 - 1.0
-    }
+    use rand::{RngExt, SeedableRng};
 
     /// Five identify runs, four of them turning over many turns (two each way) and one swinging,
     /// the validate runs at rest (no rows), each row's equation error `torque(θ)` plus noise.
     fn campaign(torque: impl Fn(f64) -> f64) -> (Vec<WeakRow>, Vec<f64>) {
         let (mut rows, mut res) = (Vec::new(), Vec::new());
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(29);
         for (run, end_rad) in [-40.0, -30.0, 30.0, 40.0, 0.0].into_iter().enumerate() {
             for k in 0..400 {
                 let s = k as f64 / 400.0;
@@ -249,7 +240,7 @@ mod tests {
                 r.theta_dot_rad_s = 5.0 * (9.0 * s + run as f64).cos();
                 r.phase = (7.0 * s * std::f64::consts::TAU).rem_euclid(std::f64::consts::TAU);
                 r.tau_s = 20.0 * s;
-                res.push(torque(r.theta) + 0.05 * noise(rows.len()));
+                res.push(torque(r.theta) + 0.05 * rng.random_range(-1.0..1.0));
                 rows.push(r);
             }
         }
