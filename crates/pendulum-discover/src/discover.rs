@@ -43,7 +43,7 @@ use crate::agreement::{
 use crate::damping::{damping_check, DampingCheck, DampingVerdict};
 use crate::drift::{drift_evidence, realigned, speed_drift_row};
 use crate::heldout::{
-    e_total, effect_heldout_gain, fall_by_factor, paired_gain, rank_z_by_factor, HELDOUT_Z,
+    e_total, effect_heldout_gain, fall_by_factor, paired_gain, rank_z_by_factor, EqFall,
 };
 pub use crate::heldout::{heldout_gain, SECOND_LOOK_GAIN_FACTOR};
 pub use crate::looks::PINNED_LOOK;
@@ -1189,6 +1189,62 @@ fn eq_reach(rows: &[WeakRow], fit: &crate::screen::Ols, current: &[usize], after
     }
 }
 
+/// The row of a candidate the first screening round tried and the search did not judge: the
+/// screen's estimate and interval (none where the interval is wider than the effect's whole
+/// range), and why it was left (screened out, a nuisance term within the rig's zeroing
+/// tolerance, or a more general form of a simpler one the screen preferred).
+fn screened_out_row(sc: &Screened, first_round: &[Screened], nuisance: &[usize]) -> DiagnosisRow {
+    let (est, se, unit) = to_si(&sc.candidate, &sc.fit);
+    let (lo, hi) = sc
+        .candidate
+        .size_band
+        .unwrap_or((est - 1.96 * se, est + 1.96 * se));
+    let band = (lo.min(est - 1.96 * se), hi.max(est + 1.96 * se));
+    // Not estimable: no estimate or interval, as for a column the screen could not separate
+    // at all (`screen_estimate` keeps the number, the note the interval).
+    let range = wider_than_its_range(&sc.candidate.effect, band.0, band.1);
+    let (value, (ci_low, ci_high)) = match range {
+        Some(_) => (f64::NAN, (f64::NAN, f64::NAN)),
+        None => (est, band),
+    };
+    // A position torque's row names its best k first.
+    let k_words = if sc.candidate.effect == "position_torque" {
+        format!("k = {}; ", sc.candidate.k)
+    } else {
+        String::new()
+    };
+    DiagnosisRow {
+        estimate: value,
+        identify_estimate: value,
+        ci_low,
+        ci_high,
+        delta_bic: sc.delta_bic,
+        screen_estimate: est,
+        note: if let Some((a, b)) = range {
+            format!(
+                "{k_words}not estimable on the identify runs: the screen's 95 % interval, [{:.4e}, {:.4e}] {unit} about {est:.4e}, is wider than the effect's whole range [{a:.4e}, {b:.4e}] (its column hardly moves on their windows: too few where the pendulum moves under the shaker); neither found nor ruled out",
+                band.0,
+                band.1,
+            )
+        } else if sc.candidate.effect == "position_torque" {
+            format!("{k_words}screened out")
+        } else if sc.candidate.add.iter().all(|c| nuisance.contains(c)) {
+            "within the rig's zeroing tolerance (under 4 counts): kept as a nuisance term, not named".into()
+        } else if let Some(simpler) = crate::screen::yields_to(first_round, sc) {
+            format!(
+                "not told from {} (ΔBIC {:.1} against its {:.1}; the more general one goes first only {:.0} lower): the simpler one was screened instead",
+                simpler.candidate.effect,
+                sc.delta_bic,
+                simpler.delta_bic,
+                crate::screen::GENERALISATION_BIC
+            )
+        } else {
+            "screened out".into()
+        },
+        ..DiagnosisRow::words_only(&sc.candidate.effect, unit, String::new())
+    }
+}
+
 /// The free segments (of `free_segments`, as passed to [`discover`]) of the runs of `role` in
 /// which the pendulum leaves rest ([`is_moving`]).
 fn moving_free_segments(free_segments: &[PreparedRun], role: Role) -> Vec<PreparedRun> {
@@ -2083,54 +2139,15 @@ pub fn discover(
         // The current model's screen fit on the identify rows (also what the free description
         // below starts from).
         let current_ols = ols(&view.id_rows, &current_cols);
-        let (eq_gain, eq_noise, reach, eq_rank_z) = match &current_ols {
+        // The validate runs' equation error as a view of the candidate ([`EqFall`]).
+        let eqf = match &current_ols {
             Some(f0) => {
-                let before = view.sq_val(f0);
                 let after = view.sq_val(&fit);
-                let (g, n) = paired_gain(&before, &after);
-                let d: Vec<f64> = before.iter().zip(&after).map(|(b, a)| b - a).collect();
-                (
-                    g,
-                    n,
-                    eq_reach(&view.val_rows, &fit, &current_cols, &after),
-                    pendulum_numerics::signed_rank_z(&d),
-                )
+                let reach = eq_reach(&view.val_rows, &fit, &current_cols, &after);
+                EqFall::measure(&view.sq_val(f0), &after, reach, cfg.eq_gain_min)
             }
-            None => (f64::NAN, f64::INFINITY, 0.0, f64::NAN),
+            None => EqFall::unknown(cfg.eq_gain_min),
         };
-        let eq_needed = cfg.eq_gain_min.max(eq_noise);
-        // Whether the validate runs' equation error confirms a fall: beyond its bar, or, where a
-        // few heavy windows carry most of its sum, by its windows' signed ranks (each window's
-        // fall against its rise, [`pendulum_numerics::signed_rank_z`], at the same one-sided
-        // 97.5 %) with the fall still beyond the smallest that counts. The spread of the paired
-        // differences cannot tell any fall from chance where a handful of windows hold the sum
-        // (its sign hangs on them): a hidden 0.096 kg/m drag on a drawn design whose rotating
-        // validate windows dominate (`SURVEY_DAMPING=drawn SURVEY_SEED=17`,
-        // `viscous_quadratic` k=3, `--base linear`) was screened at 0.1006 (ΔBIC −352) and
-        // refitted at 0.0960, and the validate runs' equation error fell 97.9 % against a
-        // "noise" of 98.8 % while their windows' ranks leaned to the fall at z = 5.6. Only a
-        // fall: every rise keeps the spread's bar.
-        let eq_ranked = eq_rank_z > HELDOUT_Z && eq_gain > cfg.eq_gain_min;
-        let eq_confirms = eq_gain > eq_needed || eq_ranked;
-        // The ranks' pass by the margin a lone view must clear ([`fall_by_factor`]: a fall
-        // cleared twice leaves the square of what one leaves), on the ranks' own scale: a
-        // chance of one in forty squared ([`rank_z_by_factor`]), the fall beyond the smallest
-        // that counts cleared as often.
-        let eq_ranked_by_margin = eq_rank_z > rank_z_by_factor(SECOND_LOOK_GAIN_FACTOR)
-            && eq_gain > fall_by_factor(cfg.eq_gain_min, SECOND_LOOK_GAIN_FACTOR);
-        let eq_clears_margin =
-            eq_gain > fall_by_factor(eq_needed, SECOND_LOOK_GAIN_FACTOR) || eq_ranked_by_margin;
-        // Whether the validate runs' equation error could see the candidate at all: the fall it
-        // would show were the candidate true at the identify runs' size ([`eq_reach`])
-        // beyond the bar a fall must clear. A view that could not see it neither confirms it
-        // by its silence nor contradicts it by a rise within its noise. A breakaway (stribeck)
-        // acts only within a few v_s of the turning points, in a handful of windows whose rate
-        // is measured from quantised angles at the scale of v_s itself: a hidden 7.5e-3 N·m
-        // one, screened at 6.7e-3 (ΔBIC −17) and refitted at 6.1e-3, took 20.5 % ± 7.9 % off
-        // the validate runs' E_θ while their equation error moved −15 % ± 33 %; another
-        // (1.49e-2, screen 1.17e-2 at ΔBIC −82, refit 1.41e-2) 29.3 % ± 15.4 % against an
-        // equation-error fall of 35 % ± 49 %.
-        let eq_powered = reach > eq_needed;
         let mut ci = (est - 1.96 * se, est + 1.96 * se);
         // A shaped effect's size is known only as well as its shape's profile allows.
         if let Some((lo, hi)) = c.size_band.filter(|_| !nonlinear) {
@@ -2183,10 +2200,10 @@ pub fn discover(
         // SURVEY_SEED=15`, `encoder_offset` k=2), refitted at −0.0401 with the base freed from
         // its bound (μ 0.153, truth 0.154) and taking 96.4 % ± 23.4 % off the validate runs'
         // E_θ, was refused because that error "rose" 0.006 %, beyond its noise of less.
-        let eq_rise_counts = eq_gain < -eq_needed;
-        let eq_contradicts = eq_judges && eq_gain < 0.0 && (eq_powered || eq_rise_counts);
+        let eq_rise_counts = eqf.gain < -eqf.needed;
+        let eq_contradicts = eq_judges && eqf.gain < 0.0 && (eqf.powered || eq_rise_counts);
         // (Both this rule and the next hold only where that view could see the candidate,
-        // `eq_powered`, but for an offset's silence, below.)
+        // `EqFall::powered`, but for an offset's silence, below.)
         // Where that direct view neither rises nor confirms (its fall within its noise), the
         // E_θ fall stands alone and must clear its bar by the second look's margin: one view's
         // bare pass is not two views agreeing. A k = 27 cogging torque (2.5e-3 N·m) was named
@@ -2200,7 +2217,7 @@ pub fn discover(
         // validate runs' equation error rose 2.6 %; a −0.032 rad offset beside an extra inertia
         // takes 94.5 % ± 17.2 % off their E_θ while that error moves −0.04 % (noise 0.08 %).
         let eq_silent =
-            eq_judges && !eq_confirms && (eq_powered || effect.kind() == Kind::Observation);
+            eq_judges && !eqf.confirms && (eqf.powered || effect.kind() == Kind::Observation);
         let e_theta_alone = gain > gain_needed
             && !eq_contradicts
             && (!eq_silent || gain > SECOND_LOOK_GAIN_FACTOR * gain_needed);
@@ -2261,7 +2278,7 @@ pub fn discover(
         // equation error, 28.7 % against 24.1 % needed (42.5 % by the margin), their E_θ moving
         // −164 % ± 230 %; the 5.2 ms lag above takes 99.9 % off against 78.5 % (95.4 %).
         let e_theta_cannot_see =
-            !silent && !e_theta_alone && eq_confirms && e_theta_blind(&val_runs)?;
+            !silent && !e_theta_alone && eqf.confirms && e_theta_blind(&val_runs)?;
         let blind = e_theta_cannot_see && gain <= -noise;
         let blind_excused = blind && trade_excusable;
         // Unless the identify runs' trajectories measure the size themselves: they tell it from
@@ -2279,11 +2296,11 @@ pub fn discover(
         let trajectories_measure = !blind
             && size_power == Some(true)
             && size_index.is_some_and(|i| refit_within_band(est, 1.96 * se, refit_x[i]));
-        let lone_short = e_theta_cannot_see && !trajectories_measure && !eq_clears_margin;
+        let lone_short = e_theta_cannot_see && !trajectories_measure && !eqf.clears_margin;
         let held_out = if silent {
-            gain > gain_needed && eq_confirms
+            gain > gain_needed && eqf.confirms
         } else {
-            (e_theta_alone || (eq_confirms && (gain > -noise || blind_excused))) && !lone_short
+            (e_theta_alone || (eqf.confirms && (gain > -noise || blind_excused))) && !lone_short
         };
         // The refitted value of the effect's size.
         let refit_est = size_index.map_or(f64::NAN, |i| refit_x[i]);
@@ -2539,7 +2556,7 @@ pub fn discover(
         // 36, `encoder_offset` k=0), taking 99.2 % ± 15.0 % off the validate runs' E_θ, was
         // refused over a remainder of −1.82e-3 N·m/rad × θ (1.31e-3 N·m rms, a seventieth of
         // the offset's own torque) confirmed by a fall of 0.536 against a noise of 0.525.
-        let angle_remains = (effect.reads_hanging_position() || !eq_confirms)
+        let angle_remains = (effect.reads_hanging_position() || !eqf.confirms)
             && possible
             && significant
             && partial.is_none()
@@ -2740,7 +2757,7 @@ pub fn discover(
             // comparison too.) (Beyond the bar a fall must clear, `eq_rise_counts`.)
             let eq_rises = nonlinear && eq_rise_counts;
             // A shaped effect the validate runs' equation error could not see (the fall it would
-            // show at the screen's size is inside its bar, `eq_powered`) is neither confirmed nor
+            // show at the screen's size is inside its bar, `EqFall::powered`) is neither confirmed nor
             // contradicted by that view's silence, as on the screen route; where it does not
             // rise at either shape (the screen's or the trajectories'), the trajectories telling
             // the size from its absence and the E_θ fall beyond twice its bar carry it. A hidden
@@ -2752,8 +2769,8 @@ pub fn discover(
             // named. (Not for an unshaped torque: its columns are exact in every window, and the
             // two dry torques named from nothing on drawn designs had that view rise.)
             let eq_blind_not_against = c.shaped().is_some()
-                && !eq_powered
-                && eq_gain >= 0.0
+                && !eqf.powered
+                && eqf.gain >= 0.0
                 && at_trajectories_shape.is_some_and(|(_, _, _, g, _)| g >= 0.0);
             let margin = if free_segments_measure || hanging_measures {
                 1.0
@@ -2762,7 +2779,7 @@ pub fn discover(
             };
             let others_pass = plausible
                 && (informative || shape_views_agree)
-                && (eq_confirms
+                && (eqf.confirms
                     || shape_views_agree
                     || hanging_measures
                     || (informative && eq_blind_not_against)
@@ -3305,7 +3322,7 @@ pub fn discover(
         // each report called it an unexplained departure. (Asking the held-out rows to confirm
         // it instead silenced three real encoder backlashes of the fresh departures, whose
         // impossible accelerometer lead or negative dry torque those rows do not confirm.)
-        let heldout_rejects = eq_gain < -eq_noise;
+        let heldout_rejects = eqf.gain < -eqf.noise;
         if screen_route
             && !possible
             && !heldout_rejects
@@ -3539,7 +3556,7 @@ pub fn discover(
             delta_bic: sc.delta_bic,
             heldout_gain: gain,
             heldout_noise: noise,
-            heldout_eq_gain: eq_gain,
+            heldout_eq_gain: eqf.gain,
             screen_estimate: est,
             refit_estimate: refit_est,
             refit_ci_low: refit_range.map_or(f64::NAN, |r| r.0),
@@ -3615,8 +3632,8 @@ pub fn discover(
                 },
                 refit_est,
                 unit,
-                100.0 * eq_gain,
-                100.0 * eq_needed,
+                100.0 * eqf.gain,
+                100.0 * eqf.needed,
                 f,
                 gain_needed,
                 noise
@@ -3699,38 +3716,39 @@ pub fn discover(
         // row gives every reason that holds.)
         if e_theta_cannot_see
             && trajectories_measure
-            && eq_gain <= fall_by_factor(eq_needed, SECOND_LOOK_GAIN_FACTOR)
+            && eqf.gain <= fall_by_factor(eqf.needed, SECOND_LOOK_GAIN_FACTOR)
         {
             row.note.push_str(&format!(
                 "; {E_THETA_BLIND}, on its own bar, not {SECOND_LOOK_GAIN_FACTOR} times over ({:.1} %), because the identify runs' trajectories measure its size (they tell it from its absence, and their refit lies within the screen's interval or 10 %)",
-                100.0 * fall_by_factor(eq_needed, SECOND_LOOK_GAIN_FACTOR)
+                100.0 * fall_by_factor(eqf.needed, SECOND_LOOK_GAIN_FACTOR)
             ));
         }
         if lone_short {
             row.note.push_str(&format!(
                 "; {E_THETA_BLIND}, and its fall of {:.1} % does not clear its bar {SECOND_LOOK_GAIN_FACTOR} times over ({:.1} %): not accepted",
-                100.0 * eq_gain,
-                100.0 * fall_by_factor(eq_needed, SECOND_LOOK_GAIN_FACTOR)
+                100.0 * eqf.gain,
+                100.0 * fall_by_factor(eqf.needed, SECOND_LOOK_GAIN_FACTOR)
             ));
         }
         // Which test confirmed the equation error's fall, where the ranks did what the spread
         // could not: its bar once, or twice over for a view that judges alone.
         let margin_by_ranks = e_theta_cannot_see
-            && eq_ranked_by_margin
-            && !(eq_gain > fall_by_factor(eq_needed, SECOND_LOOK_GAIN_FACTOR));
-        if (eq_ranked && !(eq_gain > eq_needed)) || margin_by_ranks {
+            && eqf.ranked_by_margin
+            && !(eqf.gain > fall_by_factor(eqf.needed, SECOND_LOOK_GAIN_FACTOR));
+        if (eqf.ranked && !(eqf.gain > eqf.needed)) || margin_by_ranks {
             let (asked, twice) = if margin_by_ranks {
                 (
-                    fall_by_factor(eq_needed, SECOND_LOOK_GAIN_FACTOR),
+                    fall_by_factor(eqf.needed, SECOND_LOOK_GAIN_FACTOR),
                     format!(", its bar {SECOND_LOOK_GAIN_FACTOR} times over"),
                 )
             } else {
-                (eq_needed, String::new())
+                (eqf.needed, String::new())
             };
             row.note.push_str(&format!(
-                "; the validate runs' equation error falls {:.1} %, short of the {:.1} % the spread of its windows' differences asks{twice} (a few heavy windows can carry that spread), and its windows' signed ranks confirm the fall (z = {eq_rank_z:.2}{})",
-                100.0 * eq_gain,
+                "; the validate runs' equation error falls {:.1} %, short of the {:.1} % the spread of its windows' differences asks{twice} (a few heavy windows can carry that spread), and its windows' signed ranks confirm the fall (z = {:.2}{})",
+                100.0 * eqf.gain,
                 100.0 * asked,
+                eqf.rank_z,
                 if margin_by_ranks {
                     format!(
                         ", clearing their bar {SECOND_LOOK_GAIN_FACTOR} times over, beyond {:.2}, as a view judging alone must",
@@ -3747,10 +3765,10 @@ pub fn discover(
             );
         }
         // (Only where it did not confirm it anyway: a view may clear its bar beyond its reach.)
-        if !nonlinear && !eq_powered && !second_look && !eq_confirms {
+        if !nonlinear && !eqf.powered && !second_look && !eqf.confirms {
             row.note.push_str(&format!(
                 "; the validate runs' equation error cannot see it (were it true at the screen's size, it would fall {:.1} %, short of its bar): it neither confirms nor contradicts, and E_θ judges it",
-                100.0 * reach
+                100.0 * eqf.reach
             ));
         }
         if counts_blur_screen && !second_look {
@@ -3828,7 +3846,7 @@ pub fn discover(
             ));
         }
         if let Some((shape, e, s, g, _)) = at_trajectories_shape
-            .filter(|_| accepted && shape_views_agree && !(informative && eq_confirms))
+            .filter(|_| accepted && shape_views_agree && !(informative && eqf.confirms))
         {
             row.note.push_str(&format!(
                 "; at the trajectories' shape ({shape:.4}) the identify runs' equation error holds it at {e:.4e} ± {:.4e} {unit} and the validate runs' falls {:.1} %: the two views on the identify runs agree",
@@ -3843,7 +3861,7 @@ pub fn discover(
                 100.0 * g
             ));
         }
-        if accepted && second_look && unpins && !eq_confirms {
+        if accepted && second_look && unpins && !eqf.confirms {
             row.note.push_str(
                 "; with it the base parameters' refit leaves the bounds that pinned the base fit",
             );
@@ -4244,55 +4262,7 @@ pub fn discover(
             rows.push(row);
             continue;
         }
-        let (est, se, unit) = to_si(&sc.candidate, &sc.fit);
-        let (lo, hi) = sc
-            .candidate
-            .size_band
-            .unwrap_or((est - 1.96 * se, est + 1.96 * se));
-        let band = (lo.min(est - 1.96 * se), hi.max(est + 1.96 * se));
-        // Not estimable: no estimate or interval, as for a column the screen could not separate
-        // at all (`screen_estimate` keeps the number, the note the interval).
-        let range = wider_than_its_range(&sc.candidate.effect, band.0, band.1);
-        let (value, (ci_low, ci_high)) = match range {
-            Some(_) => (f64::NAN, (f64::NAN, f64::NAN)),
-            None => (est, band),
-        };
-        // A position torque's row names its best k first.
-        let k_words = if sc.candidate.effect == "position_torque" {
-            format!("k = {}; ", sc.candidate.k)
-        } else {
-            String::new()
-        };
-        rows.push(DiagnosisRow {
-            estimate: value,
-            identify_estimate: value,
-            ci_low,
-            ci_high,
-            delta_bic: sc.delta_bic,
-            screen_estimate: est,
-            note: if let Some((a, b)) = range {
-                format!(
-                    "{k_words}not estimable on the identify runs: the screen's 95 % interval, [{:.4e}, {:.4e}] {unit} about {est:.4e}, is wider than the effect's whole range [{a:.4e}, {b:.4e}] (its column hardly moves on their windows: too few where the pendulum moves under the shaker); neither found nor ruled out",
-                    band.0,
-                    band.1,
-                )
-            } else if sc.candidate.effect == "position_torque" {
-                format!("{k_words}screened out")
-            } else if sc.candidate.add.iter().all(|c| screened.nuisance.contains(c)) {
-                "within the rig's zeroing tolerance (under 4 counts): kept as a nuisance term, not named".into()
-            } else if let Some(simpler) = crate::screen::yields_to(first_round, sc) {
-                format!(
-                    "not told from {} (ΔBIC {:.1} against its {:.1}; the more general one goes first only {:.0} lower): the simpler one was screened instead",
-                    simpler.candidate.effect,
-                    sc.delta_bic,
-                    simpler.delta_bic,
-                    crate::screen::GENERALISATION_BIC
-                )
-            } else {
-                "screened out".into()
-            },
-            ..DiagnosisRow::words_only(&sc.candidate.effect, unit, String::new())
-        });
+        rows.push(screened_out_row(sc, first_round, &screened.nuisance));
     }
 
     // A candidate the first round could not estimate at all (its column not separable from the
