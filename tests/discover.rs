@@ -2673,6 +2673,28 @@ fn a_breakaway_whose_trajectories_range_leaves_out_zero_reads_it_as_its_interval
     assert_named_within_trajectories_range(&s, "stribeck", truth);
 }
 
+/// A 6.69e-2 kg/m quadratic drag under the linear base on a drawn design (`SURVEY_DAMPING=drawn
+/// SURVEY_SEED=48`, `viscous_quadratic` k=0, the rig's μ drawn 0), screened at ΔBIC −1918 and
+/// taking 99.6 % off the validate runs' equation error, was refused as a size that follows the
+/// run. Its validate rows' weights came from the base's own residuals (the whole catalogue's
+/// fit is singular on their three runs), which carry the drag itself, so one run's 13
+/// free-decay windows were 50 times noisier than their weights said beside the others', and
+/// that run put the size at 1.03 ± 0.10 kg/m (p = 1.5e-16 over the three). Each run's rows are
+/// now scaled to their own residuals before Chow's F (`sizes_by_group`): named alone within
+/// 10 %.
+#[test]
+#[ignore = "slow set (a survey draw: `viscous_quadratic` k=0 at SURVEY_DAMPING=drawn SURVEY_SEED=48): the default suite checks the property on discover::tests::a_run_noisier_than_its_weights_say_does_not_split_the_size; README, Tests"]
+fn a_drag_is_not_refused_for_a_run_noisier_than_its_weights_say() {
+    let (truth, s) =
+        run_as_surveyed_with_damping("viscous_quadratic", 4_801_100, 4_809_100, 4_805_100);
+    let row = named_alone(&s, "viscous_quadratic");
+    assert!(
+        (row.estimate - truth).abs() <= 0.10 * truth,
+        "estimate {:.4e} vs truth {truth:.4e}",
+        row.estimate
+    );
+}
+
 /// A 1.19e-2 N·m breakaway fading at 0.44 rad/s on a drawn design (`SURVEY_DAMPING=drawn
 /// SURVEY_SEED=41`, `stribeck` k=0), screened at +3.7 % (ΔBIC −20.1), refitted at −10.7 % and
 /// confirmed by the validate runs' equation error (a fall of 52.2 % against 34.7 %), was refused

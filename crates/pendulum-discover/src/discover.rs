@@ -4876,6 +4876,58 @@ mod tests {
         );
     }
 
+    /// The rows' weights saying one noise (0.01 N·m) in every run while one run of 100 windows,
+    /// beside four of 300, is 30 times noisier (weights set on another fit, as a validate
+    /// view's are). Chow's F pools one variance, and that run's noise swamps it: a size that
+    /// follows the run (0.7–1.15 times the named in the four precise runs) went untold
+    /// (p = 0.74 without the scaling), and the runs' spread read the noisy run's scatter. Each
+    /// run's rows are scaled to their own residuals first (`sizes_by_group`): one size holds
+    /// where there is one, a size that follows the run is told, and its spread is the precise
+    /// runs'. (The campaign that asked for it went the other way: a noisy run whose own size
+    /// took part of its misfit read as a size of its own, p = 1.5e-16.)
+    #[test]
+    fn a_run_noisier_than_its_weights_say_does_not_split_the_size() {
+        let ncol = crate::weak::columns().len();
+        let drag = crate::weak::column_of("viscous_linear").unwrap();
+        let dry = crate::weak::column_of("coulomb_constant").unwrap();
+        let cols = [drag, dry];
+        let mut unit = xorshift_uniform();
+        let mut rows_with = |size: &dyn Fn(usize) -> f64| {
+            (0..1300)
+                .map(|i| {
+                    let run = if i < 1200 { i % 4 } else { 4 };
+                    let rate = 5.0 * (2.0 * unit() - 1.0);
+                    let noise = if run == 4 { 0.3 } else { 0.01 };
+                    let e = noise * (2.0 * unit() - 1.0) * 3f64.sqrt();
+                    let mut x = vec![0.0; ncol];
+                    x[drag] = rate;
+                    x[dry] = rate.signum();
+                    let target = 0.3 * rate + size(run) * x[dry] + e;
+                    let mut r = crate::weak::test_row(run, 0.1, x, target);
+                    r.theta_dot_rad_s = rate;
+                    r
+                })
+                .collect::<Vec<WeakRow>>()
+        };
+        let candidate = Candidate {
+            effect: "coulomb_constant".into(),
+            add: vec![dry],
+            replaces: None,
+            k: 0,
+            shape: 0.0,
+            size_band: None,
+        };
+        let named = 0.01;
+        let one = one_size_in_every_run(&rows_with(&|_| named), &cols, &candidate).unwrap();
+        assert!(one.p > ONE_SIZE_P && !one.refuses(named), "{one:?}");
+        let follows = |r: usize| named * (0.7 + 0.15 * r as f64);
+        let spread = one_size_in_every_run(&rows_with(&follows), &cols, &candidate).unwrap();
+        assert!(spread.p < ONE_SIZE_P && spread.refuses(named), "{spread:?}");
+        // The spread is the four precise runs' own (their sizes 0.7, 0.85, 1.0 and 1.15 times
+        // the named: a standard deviation of 1.68e-3), the noisy run counting for its precision.
+        assert!((spread.apart - 1.68e-3).abs() < 4e-4, "{spread:?}");
+    }
+
     #[test]
     fn a_torque_in_a_few_windows_reaches_less_than_its_noise() {
         let ncol = crate::weak::columns().len();
