@@ -183,10 +183,10 @@ pub(crate) fn sizes_by_group(
     group: &dyn Fn(&WeakRow) -> usize,
 ) -> Option<GroupSizes> {
     let (_, split, two) = split_fit(rows, cols, c, group)?;
-    // The rows' weights were set on another fit's residuals ([`crate::weak::set_weights`], the
-    // identify runs' whole catalogue), and on other rows they can be off by a different factor
-    // in each run (a validate run's own zeroing error is no column of that fit); while the F
-    // test pools one variance over every run. So each run's rows are first scaled to a mean
+    // The rows' weights were set on another fit's residuals ([`crate::weak::set_weights`]): the
+    // whole catalogue's, or where that fit is singular (a validate view of three runs) the
+    // base's own, which carry a missing term's torque, more in some runs than in others. So
+    // they can be off by a different factor in each run, while the F test pools one variance. So each run's rows are first scaled to a mean
     // weighted square residual of 1 under the split fit (the size free in each group, so that
     // a departure the split describes does not count as its run's noise), as `set_weights`
     // does per run, and the test is made on the rows so weighted. Without it a hidden
