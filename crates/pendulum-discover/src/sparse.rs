@@ -1208,6 +1208,50 @@ mod tests {
         assert!(!cmp.partial(), "{cmp:?}");
     }
 
+    /// A viscous drag strongest over part of the turn (an eddy-current brake near the top:
+    /// c (1 + cos(θ − 2.65))/2 θ̇) is a freer shape of a linear drag's own (θ̇ times a harmonic
+    /// of θ beside θ̇): a drag of one size everywhere explains it only in part, and the
+    /// description holds the brake's terms at their sizes (c/2 cos φ on θ̇ cos θ, c/2 sin φ on
+    /// θ̇ sin θ). A drag that does not vary is not refused for the new terms.
+    #[test]
+    fn a_viscous_drag_that_varies_around_the_turn_makes_a_linear_drag_partial() {
+        let x = |_: f64, thd: f64, _: f64| vec![thd];
+        let family = [Variable::Rate];
+        let (c, phi) = (1.44e-2, 2.65_f64);
+        let brake = comparison_rows(1.9, x, |th, thd, _| {
+            c * (1.0 + (th - phi).cos()) / 2.0 * thd
+        });
+        let cmp = family_beats_candidate(&brake, &[], &[], &[0], &family).unwrap();
+        assert!(cmp.partial(), "{cmp:?}");
+        // Described alone (no catalogue column beside it), fitted on four of the five runs.
+        let residual: Vec<f64> = brake.iter().map(|r| r.target).collect();
+        let lib: Vec<Vec<f64>> = brake.iter().map(|r| r.lib.clone()).collect();
+        let centre: Vec<[f64; LIBRARY.len()]> =
+            lib.iter().map(|v| std::array::from_fn(|k| v[k])).collect();
+        let is_id: Vec<bool> = brake.iter().map(|r| r.run != 4).collect();
+        let d = describe(&brake, &residual, &lib, &[], 0.0, &is_id, &centre, &[])
+            .expect("a description");
+        let coef = |name: &str| {
+            d.terms
+                .iter()
+                .find(|(j, _, _)| LIBRARY[*j].name == name)
+                .map(|&(_, b, _)| b)
+        };
+        for (name, truth) in [
+            ("θ̇ cos θ", c / 2.0 * phi.cos()),
+            ("θ̇ sin θ", c / 2.0 * phi.sin()),
+        ] {
+            let b = coef(name).unwrap_or(f64::NAN);
+            assert!(
+                (b - truth).abs() < 0.05 * truth.abs(),
+                "{name}: {b} vs {truth}: {d:?}"
+            );
+        }
+        let even = comparison_rows(1.9, x, |_, thd, _| c * thd);
+        let cmp = family_beats_candidate(&even, &[], &[], &[0], &family).unwrap();
+        assert!(!cmp.partial(), "{cmp:?}");
+    }
+
     /// A freer shape the identify rows prefer refuses the candidate only where the validate rows
     /// do not contradict it: a dry friction varying around the turn on the identify rows makes
     /// a constant dry torque partial where the validate rows vary the same way, not where they
