@@ -4815,6 +4815,51 @@ mod tests {
         assert!(one_size_at_every_speed(&rows, &with_many, &many).is_none());
     }
 
+    /// The run split's test model: a viscous column beside a constant dry torque's, and the dry
+    /// torque as the candidate.
+    fn dry_torque_beside_a_drag() -> ([usize; 2], Candidate) {
+        let drag = crate::weak::column_of("viscous_linear").unwrap();
+        let dry = crate::weak::column_of("coulomb_constant").unwrap();
+        let candidate = Candidate {
+            effect: "coulomb_constant".into(),
+            add: vec![dry],
+            replaces: None,
+            k: 0,
+            shape: 0.0,
+            size_band: None,
+        };
+        ([drag, dry], candidate)
+    }
+
+    /// `n` rows of [`dry_torque_beside_a_drag`]'s model over θ̇ uniform in (−5, 5) rad/s (`unit`
+    /// draws it, then the noise): row `i` is run `run_of(i)`'s, with a drag of 0.3 N·m per rad/s,
+    /// a dry torque of `size(run)`, uniform noise of standard deviation `noise(run)` N·m, and a
+    /// dry column `seen(run)` times the others' (a run that barely sees the term).
+    fn dry_torque_rows(
+        unit: &mut impl FnMut() -> f64,
+        n: usize,
+        run_of: &dyn Fn(usize) -> usize,
+        size: &dyn Fn(usize) -> f64,
+        noise: &dyn Fn(usize) -> f64,
+        seen: &dyn Fn(usize) -> f64,
+    ) -> Vec<WeakRow> {
+        let ([drag, dry], _) = dry_torque_beside_a_drag();
+        (0..n)
+            .map(|i| {
+                let run = run_of(i);
+                let rate = 5.0 * (2.0 * unit() - 1.0);
+                let e = noise(run) * (2.0 * unit() - 1.0) * 3f64.sqrt();
+                let mut x = vec![0.0; crate::weak::columns().len()];
+                x[drag] = rate;
+                x[dry] = seen(run) * rate.signum();
+                let target = 0.3 * rate + size(run) * x[dry] + e;
+                let mut r = crate::weak::test_row(run, 0.1, x, target);
+                r.theta_dot_rad_s = rate;
+                r
+            })
+            .collect()
+    }
+
     /// One size in every run, by construction: 5 runs of 300 windows over θ̇ in (−5, 5) rad/s,
     /// a viscous column beside a constant dry torque's (noise of 0.01 N·m). A dry torque of
     /// 0.01 N·m in every run holds one size; the same torque at 0.7–1.3 times in the five runs
@@ -4824,35 +4869,11 @@ mod tests {
     /// own size anything) does not spread the sizes.
     #[test]
     fn a_torque_of_the_rig_holds_one_size_in_every_run() {
-        let ncol = crate::weak::columns().len();
-        let drag = crate::weak::column_of("viscous_linear").unwrap();
-        let dry = crate::weak::column_of("coulomb_constant").unwrap();
-        let cols = [drag, dry];
+        let (cols, candidate) = dry_torque_beside_a_drag();
         let mut unit = xorshift_uniform();
         let mut rows_with = |size: &dyn Fn(usize) -> f64, noise: f64, faint: Option<usize>| {
-            (0..1500)
-                .map(|i| {
-                    let run = i % 5;
-                    let rate = 5.0 * (2.0 * unit() - 1.0);
-                    let e = noise * (2.0 * unit() - 1.0) * 3f64.sqrt();
-                    let seen = if faint == Some(run) { 1e-3 } else { 1.0 };
-                    let mut x = vec![0.0; ncol];
-                    x[drag] = rate;
-                    x[dry] = seen * rate.signum();
-                    let target = 0.3 * rate + size(run) * x[dry] + e;
-                    let mut r = crate::weak::test_row(run, 0.1, x, target);
-                    r.theta_dot_rad_s = rate;
-                    r
-                })
-                .collect::<Vec<WeakRow>>()
-        };
-        let candidate = Candidate {
-            effect: "coulomb_constant".into(),
-            add: vec![dry],
-            replaces: None,
-            k: 0,
-            shape: 0.0,
-            size_band: None,
+            let seen = |run| if faint == Some(run) { 1e-3 } else { 1.0 };
+            dry_torque_rows(&mut unit, 1500, &|i| i % 5, size, &|_| noise, &seen)
         };
         let named = 0.01;
         let one =
@@ -4887,35 +4908,12 @@ mod tests {
     /// took part of its misfit read as a size of its own, p = 1.5e-16.)
     #[test]
     fn a_run_noisier_than_its_weights_say_does_not_split_the_size() {
-        let ncol = crate::weak::columns().len();
-        let drag = crate::weak::column_of("viscous_linear").unwrap();
-        let dry = crate::weak::column_of("coulomb_constant").unwrap();
-        let cols = [drag, dry];
+        let (cols, candidate) = dry_torque_beside_a_drag();
         let mut unit = xorshift_uniform();
         let mut rows_with = |size: &dyn Fn(usize) -> f64| {
-            (0..1300)
-                .map(|i| {
-                    let run = if i < 1200 { i % 4 } else { 4 };
-                    let rate = 5.0 * (2.0 * unit() - 1.0);
-                    let noise = if run == 4 { 0.3 } else { 0.01 };
-                    let e = noise * (2.0 * unit() - 1.0) * 3f64.sqrt();
-                    let mut x = vec![0.0; ncol];
-                    x[drag] = rate;
-                    x[dry] = rate.signum();
-                    let target = 0.3 * rate + size(run) * x[dry] + e;
-                    let mut r = crate::weak::test_row(run, 0.1, x, target);
-                    r.theta_dot_rad_s = rate;
-                    r
-                })
-                .collect::<Vec<WeakRow>>()
-        };
-        let candidate = Candidate {
-            effect: "coulomb_constant".into(),
-            add: vec![dry],
-            replaces: None,
-            k: 0,
-            shape: 0.0,
-            size_band: None,
+            let run_of = |i| if i < 1200 { i % 4 } else { 4 };
+            let noise = |run| if run == 4 { 0.3 } else { 0.01 };
+            dry_torque_rows(&mut unit, 1300, &run_of, size, &noise, &|_| 1.0)
         };
         let named = 0.01;
         let one = one_size_in_every_run(&rows_with(&|_| named), &cols, &candidate).unwrap();
