@@ -734,16 +734,21 @@ fn described_within(name: &str, k: u64, variable: Variable, term: &str, rel: f64
     assert!(d.accepted().is_empty(), "named {:?}", d.accepted());
     let desc = d.unexplained_description.as_ref().expect("a description");
     assert_eq!(desc.variable, variable, "{desc:?}");
-    let (_, v, _) = desc
-        .terms
-        .iter()
-        .find(|(j, _, _)| LIBRARY[*j].name == term)
-        .unwrap_or_else(|| panic!("no {term} term in {desc:?}"));
+    let v = coefficient_of(desc, term);
     assert!(
         (v - size).abs() < rel * size,
         "{departure}: described as {v:.4e} × {term}"
     );
     d.unexplained.clone().unwrap_or_default()
+}
+
+/// The coefficient of the library term named `term` in a description (N·m per its unit).
+fn coefficient_of(desc: &pendulum_discover::sparse::Description, term: &str) -> f64 {
+    desc.terms
+        .iter()
+        .find(|(j, _, _)| LIBRARY[*j].name == term)
+        .map(|&(_, v, _)| v)
+        .unwrap_or_else(|| panic!("no {term} term in {desc:?}"))
 }
 
 /// A torsion spring too weak to tell from a `position_torque` k = 1 by the share it leaves
@@ -827,11 +832,7 @@ fn an_eddy_brake_is_described_in_its_own_shape_not_named() {
     );
     let desc = d.unexplained_description.as_ref().expect("a description");
     for (term, truth) in [("θ̇", c / 2.0), ("θ̇ sin θ", c / 2.0 * phi.sin())] {
-        let (_, v, _) = desc
-            .terms
-            .iter()
-            .find(|(j, _, _)| LIBRARY[*j].name == term)
-            .unwrap_or_else(|| panic!("no {term} term in {desc:?}"));
+        let v = coefficient_of(desc, term);
         assert!(
             (v - truth).abs() < 0.1 * truth.abs(),
             "{departure}: described as {v:.4e} × {term}, truth {truth:.4e}"
