@@ -43,7 +43,7 @@ use crate::agreement::{
 use crate::damping::{damping_check, DampingCheck, DampingVerdict};
 use crate::drift::{drift_evidence, realigned, speed_drift_row};
 use crate::heldout::{
-    e_total, effect_heldout_gain, fall_by_factor, paired_gain, rank_z_by_factor, EqFall,
+    e_total, effect_heldout_gain, fall_by_factor, paired_gain, rank_z_by_factor, EqFall, ThetaFall,
 };
 pub use crate::heldout::{heldout_gain, SECOND_LOOK_GAIN_FACTOR};
 pub use crate::looks::PINNED_LOOK;
@@ -2163,8 +2163,10 @@ pub fn discover(
         let after = e_total(&val_judged);
         // A torque that vanishes at rest (a loss that sets no sticking capacity) is judged where
         // the pendulum moves ([`effect_heldout_gain`]).
-        let (gain, noise) = effect_heldout_gain(effect, &before_judged, &val_judged, &held_runs);
-        let gain_needed = cfg.gain_min.max(noise);
+        let thf = ThetaFall::new(
+            effect_heldout_gain(effect, &before_judged, &val_judged, &held_runs),
+            cfg.gain_min,
+        );
         // The current model's screen fit on the identify rows (also what the free description
         // below starts from).
         let current_ols = ols(&view.id_rows, &current_cols);
@@ -2247,9 +2249,9 @@ pub fn discover(
         // takes 94.5 % ± 17.2 % off their E_θ while that error moves −0.04 % (noise 0.08 %).
         let eq_silent =
             eq_judges && !eqf.confirms && (eqf.powered || effect.kind() == Kind::Observation);
-        let e_theta_alone = gain > gain_needed
+        let e_theta_alone = thf.clears(1.0)
             && !eq_contradicts
-            && (!eq_silent || gain > SECOND_LOOK_GAIN_FACTOR * gain_needed);
+            && (!eq_silent || thf.clears(SECOND_LOOK_GAIN_FACTOR));
         // With the trajectories silent on the size (`silent`), both held-out views must
         // confirm it: the validate runs' E_θ and their equation error each beyond its bar. The
         // equation error alone named a 0.021 kg·m² "extra inertia" (the refit: 6e-4) for an
@@ -2297,7 +2299,7 @@ pub fn discover(
                 (n + r.t.len(), s.min(step))
             });
         let sub_count = samples > 0 && after <= 0.25 * step * samples as f64;
-        let trade_excusable = -gain <= SECOND_LOOK_GAIN_FACTOR * noise || sub_count;
+        let trade_excusable = thf.rise_within(SECOND_LOOK_GAIN_FACTOR) || sub_count;
         // Where E_θ cannot see the effect, the equation error judges it alone, whether E_θ rose
         // or not, and a lone view's bare pass is not two views agreeing: it must clear its bar
         // by the second look's margin, as an E_θ fall must where the equation error is silent
@@ -2308,7 +2310,7 @@ pub fn discover(
         // −164 % ± 230 %; the 5.2 ms lag above takes 99.9 % off against 78.5 % (95.4 %).
         let e_theta_cannot_see =
             !silent && !e_theta_alone && eqf.confirms && e_theta_blind(&val_runs)?;
-        let blind = e_theta_cannot_see && gain <= -noise;
+        let blind = e_theta_cannot_see && thf.rises();
         let blind_excused = blind && trade_excusable;
         // Unless the identify runs' trajectories measure the size themselves: they tell it from
         // its absence (`size_power`) and their refit lies within the screen's interval or the
@@ -2327,9 +2329,9 @@ pub fn discover(
             && size_index.is_some_and(|i| refit_within_band(est, 1.96 * se, refit_x[i]));
         let lone_short = e_theta_cannot_see && !trajectories_measure && !eqf.clears_margin;
         let held_out = if silent {
-            gain > gain_needed && eqf.confirms
+            thf.clears(1.0) && eqf.confirms
         } else {
-            (e_theta_alone || (eqf.confirms && (gain > -noise || blind_excused))) && !lone_short
+            (e_theta_alone || (eqf.confirms && (thf.no_rise() || blind_excused))) && !lone_short
         };
         // The refitted value of the effect's size.
         let refit_est = size_index.map_or(f64::NAN, |i| refit_x[i]);
@@ -2450,10 +2452,7 @@ pub fn discover(
         let needs_e_theta = agree && !refit_in_band && !e_theta_cannot_see;
         let at_screen = match &x_prof {
             Some(xp)
-                if needs_e_theta
-                    && gain > gain_needed
-                    && *xp != x
-                    && !band_split_at_refit_shape =>
+                if needs_e_theta && thf.clears(1.0) && *xp != x && !band_split_at_refit_shape =>
             {
                 let v = validate(&held_runs, &spec, xp, &cfg.validate)?;
                 let judged = judged_for(effect, &v, &free_moving_val);
@@ -2468,8 +2467,7 @@ pub fn discover(
         };
         // (Against its own noise, as every held-out gain here.)
         let screen_size_confirmed = at_screen.is_none_or(|(g, n)| g > cfg.gain_min.max(n));
-        let size_rests_on_eq_alone =
-            needs_e_theta && !(gain > gain_needed && screen_size_confirmed);
+        let size_rests_on_eq_alone = needs_e_theta && !(thf.clears(1.0) && screen_size_confirmed);
         // Unless the view free to describe the torque otherwise takes this effect's own shape:
         // the generic sparse description of what the current model leaves (its library of
         // shapes in θ̇, θ, the forcing and time, judged on the validate rows like a catalogue
@@ -2824,8 +2822,8 @@ pub fn discover(
             // drawn breakaways whose trajectories held them within [0, 2.5e-2] and [0, 3.2e-2]
             // cleared the left-out bar by 1.2 % and 2.1 % and were refitted 26 % and 34 % off.)
             let left_out = if others_pass
-                && gain <= margin * gain_needed
-                && gain >= -noise
+                && !thf.clears(margin)
+                && thf.no_rise()
                 && c.shaped().is_some()
                 && effect.sets_sticking_capacity()
                 && size_index.is_some_and(|i| shape_range.unwrap_or_else(|| range_of(i)).0 > 0.0)
@@ -2849,12 +2847,12 @@ pub fn discover(
             if let Some((g, n)) = left_out {
                 second_look_left_out = Some((g, n, margin * cfg.gain_min.max(n), left_out_passes));
             }
-            let passes = others_pass && (gain > margin * gain_needed || left_out_passes);
-            let gain = match left_out {
+            let passes = others_pass && (thf.clears(margin) || left_out_passes);
+            let recorded = match left_out {
                 Some((g, _)) if left_out_passes => g,
-                _ => gain,
+                _ => thf.gain,
             };
-            second.record(&c.effect, passes, gain)
+            second.record(&c.effect, passes, recorded)
         } else {
             plausible
                 && excludes_zero
@@ -3208,7 +3206,7 @@ pub fn discover(
             .and_then(|g| confirmed.iter().rev().find(|(e, _)| e == g))
             .map(|(_, r)| r)
             .filter(|r| {
-                accepted && !r.accepted && r.heldout_gain.is_finite() && r.heldout_gain >= gain
+                accepted && !r.accepted && r.heldout_gain.is_finite() && r.heldout_gain >= thf.gain
             })
             .map(|r| (r.effect.clone(), r.heldout_gain));
         let accepted = accepted && outdone_by_simpler.is_none();
@@ -3583,8 +3581,8 @@ pub fn discover(
             ci_high,
             unit: unit.into(),
             delta_bic: sc.delta_bic,
-            heldout_gain: gain,
-            heldout_noise: noise,
+            heldout_gain: thf.gain,
+            heldout_noise: thf.noise,
             heldout_eq_gain: eqf.gain,
             screen_estimate: est,
             refit_estimate: refit_est,
@@ -3652,9 +3650,9 @@ pub fn discover(
                     "; the trajectories fit the screen's value as well as their own refit's (beyond the screen's interval and 10 %), so they do not measure its size, and the validate runs' E_θ does not fall beyond its bar: its size rests on the equation error alone, not named"
                 } else if second_look && !informative && !shape_views_agree {
                     "; the trajectories cannot tell it from its absence (its refit set to 0 is not significantly worse on the identify runs): not accepted"
-                } else if eq_contradicts && gain > gain_needed && !second_look {
+                } else if eq_contradicts && thf.clears(1.0) && !second_look {
                     "; the validate runs' equation error rises: the held-out views disagree, not accepted"
-                } else if eq_silent && gain > gain_needed && !e_theta_alone && !second_look {
+                } else if eq_silent && thf.clears(1.0) && !e_theta_alone && !second_look {
                     "; the validate runs' equation error does not confirm it and the E_θ fall alone is short of twice its bar: not accepted"
                 } else {
                     ""
@@ -3664,8 +3662,8 @@ pub fn discover(
                 100.0 * eqf.gain,
                 100.0 * eqf.needed,
                 f,
-                gain_needed,
-                noise
+                thf.needed,
+                thf.noise
             ),
         };
         let mut row = row;
@@ -3699,7 +3697,7 @@ pub fn discover(
         if let Some((simpler, g)) = &outdone_by_simpler {
             row.note.push_str(&format!(
                 "; it does no better on the validate runs' E_θ ({:.1} %) than the {simpler} it becomes at the limit of its shape, which the held-out views refused ({:.1} %): not named",
-                100.0 * gain,
+                100.0 * thf.gain,
                 100.0 * g
             ));
         }
@@ -3726,7 +3724,7 @@ pub fn discover(
             row.note.push_str(
                 "; the validate runs' E_θ does not respond to the effect itself (its size set to 0 in the refitted model scores within the noise): their E_θ cannot see it, and its rise is the other terms' trade",
             );
-            if sub_count && -gain > SECOND_LOOK_GAIN_FACTOR * noise {
+            if sub_count && !thf.rise_within(SECOND_LOOK_GAIN_FACTOR) {
                 row.note.push_str(&format!(
                     " (under a quarter of an encoder step per sample, {:.1e} rad, the quantisation's own mean error: one the encoder cannot see)",
                     after / samples as f64

@@ -171,6 +171,53 @@ impl EqFall {
     }
 }
 
+/// The validate runs' E_θ as a view of a candidate: its paired fall from the model in hand to the
+/// model with the candidate ([`effect_heldout_gain`]), the noise that fall must beat, and the bar.
+/// Every clause of the judgement that asks this view reads it here.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct ThetaFall {
+    /// The paired fall 1 − Σafter/Σbefore over the validate runs' segments.
+    pub(crate) gain: f64,
+    /// The noise that fall must beat ([`paired_gain`]).
+    pub(crate) noise: f64,
+    /// The bar a fall must clear: the larger of the smallest fall that counts and the noise.
+    pub(crate) needed: f64,
+}
+
+impl ThetaFall {
+    /// The view from a fall and its noise (`(gain, noise)`, as [`effect_heldout_gain`] returns
+    /// them) and the smallest fall that counts (`min_gain`).
+    pub(crate) fn new((gain, noise): (f64, f64), min_gain: f64) -> Self {
+        Self {
+            gain,
+            noise,
+            needed: min_gain.max(noise),
+        }
+    }
+
+    /// The fall clears its bar `margin` times over (1: the bar itself; a view judging alone
+    /// asks more).
+    pub(crate) fn clears(&self, margin: f64) -> bool {
+        self.gain > margin * self.needed
+    }
+
+    /// E_θ rises by its noise or more: the view leans against the candidate.
+    pub(crate) fn rises(&self) -> bool {
+        self.gain <= -self.noise
+    }
+
+    /// Any rise is within the noise (and the fall is a number).
+    pub(crate) fn no_rise(&self) -> bool {
+        self.gain > -self.noise
+    }
+
+    /// A rise, if any, is within `factor` times the noise: the most a trade between the other
+    /// terms may cost.
+    pub(crate) fn rise_within(&self, factor: f64) -> bool {
+        -self.gain <= factor * self.noise
+    }
+}
+
 /// Paired units of two validations of the same runs: their multiple-shooting segments, which
 /// restart from the measured state and so err nearly independently (a run whose segments do not
 /// pair up, e.g. after a re-alignment, counts as one unit).
@@ -275,6 +322,29 @@ mod tests {
     /// A fall cleared `factor` times over is two falls in a row: the error left after both is
     /// the product of what each leaves. Factor 1 is the bar itself, and no bar below 100 % asks
     /// for 100 % or more (twice a 78.5 % bar, linearly, would ask for 157 %).
+    #[test]
+    fn an_e_theta_fall_clears_the_larger_of_its_noise_and_the_smallest_that_counts() {
+        // A noisy view: its noise sets the bar.
+        let noisy = ThetaFall::new((0.15, 0.10), 0.02);
+        assert_eq!(noisy.needed, 0.10);
+        assert!(noisy.clears(1.0) && !noisy.clears(2.0));
+        // A quiet one: the smallest fall that counts sets it.
+        let quiet = ThetaFall::new((0.03, 0.001), 0.02);
+        assert_eq!(quiet.needed, 0.02);
+        assert!(quiet.clears(1.0) && !quiet.clears(2.0));
+        assert!(quiet.no_rise() && !quiet.rises());
+    }
+
+    #[test]
+    fn an_e_theta_rise_beyond_its_noise_leans_against_the_candidate() {
+        let within = ThetaFall::new((-0.05, 0.10), 0.02);
+        assert!(within.no_rise() && !within.rises() && within.rise_within(1.0));
+        let beyond = ThetaFall::new((-0.15, 0.10), 0.02);
+        assert!(!beyond.no_rise() && beyond.rises() && !beyond.clears(1.0));
+        // A trade may cost up to its factor times the noise.
+        assert!(beyond.rise_within(2.0) && !beyond.rise_within(1.0));
+    }
+
     #[test]
     fn a_fall_cleared_twice_leaves_the_square_of_what_one_leaves() {
         for bar in [0.05, 0.241, 0.5, 0.785, 0.999] {
