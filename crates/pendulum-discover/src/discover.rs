@@ -50,8 +50,9 @@ pub use crate::looks::PINNED_LOOK;
 use crate::looks::{PairLook, SecondLook};
 pub use crate::readings::ACCEL_GAIN_FLOOR;
 use crate::readings::{
-    accel_gain_row, hanging_interval, hangs_as_an_offset, horizontal_slopes, joined_with_reading,
-    per_run_mean, sensor_heldout, t95, tilt_reading, zeroing_half, TiltJudge, SENSOR_HELDOUT_GAIN,
+    accel_gain_row, hanging_interval, hangs_as_an_offset, hangs_by_the_bob, horizontal_slopes,
+    joined_with_reading, per_run_mean, sensor_heldout, t95, tilt_reading, zeroing_half, TiltJudge,
+    SENSOR_HELDOUT_GAIN,
 };
 use crate::screen::{ols, stepwise, stepwise_from, with_candidate, Base, Candidate, Screened};
 use crate::trajectories::{
@@ -1436,6 +1437,27 @@ pub fn discover(
             (mgl > 0.0).then_some((mgl, h))
         })
         .collect();
+    // Where the free decays hang reads an offset of the reading only where every bob hangs at
+    // one angle ([`hangs_by_the_bob`], asked of every run's centre: a refusal the validate runs
+    // may give): a torque the bob balances tilts each bob by its own m g l, and then the
+    // centres read no offset at all.
+    let centres_follow_the_bob = {
+        let every: Vec<(f64, f64)> = ctx
+            .runs
+            .iter()
+            .filter_map(|r| {
+                let h = ctx.hanging.get(&r.id).copied().flatten()?;
+                let mgl = r.rig.m_kg * r.rig.g_m_s2 * r.rig.l_m;
+                (mgl > 0.0).then_some((mgl, h))
+            })
+            .collect();
+        hangs_by_the_bob(&every)
+    };
+    let hanging_offset = if centres_follow_the_bob {
+        None
+    } else {
+        hanging_interval(&hanging_id)
+    };
     let mut val_runs = ctx.prepared(Role::Validate, &cfg.validate.window, "discover")?;
     if !ctx.runs.iter().any(|r| r.role == Role::Identify) {
         return Err(ProcessError::BadConfig {
@@ -1702,7 +1724,7 @@ pub fn discover(
     // [−8.1e-2, 1.3e-2] (ΔBIC +3.5) while the five identify runs' free decays swung about
     // −0.030 to −0.036 rad; nothing was named, and the k = 1 position torque that its refit
     // sized as the offset (7.85e-2 N·m, its screen 1.8e-3) was refused.
-    let hanging_read: Vec<Screened> = match hanging_interval(&hanging_id) {
+    let hanging_read: Vec<Screened> = match hanging_offset {
         Some(h) if h.0 > 0.0 || h.1 < 0.0 => first_round
             .iter()
             .filter(|sc| {
@@ -2196,7 +2218,7 @@ pub fn discover(
         // +0.055 to +0.064 rad; it was not named ("interval includes 0").
         let hanging_reads = effect.reads_hanging_position()
             && !(ci.0 > 0.0 || ci.1 < 0.0)
-            && hanging_interval(&hanging_id)
+            && hanging_offset
                 .filter(|h| (h.0 > 0.0 || h.1 < 0.0) && h.0 <= est && est <= h.1)
                 .map(|h| ci = h)
                 .is_some();
@@ -2751,7 +2773,7 @@ pub fn discover(
         let hanging_measures = second_look
             && effect.reads_hanging_position()
             && !refit_pinned
-            && hanging_interval(&hanging_id)
+            && hanging_offset
                 .is_some_and(|h| (h.0 > 0.0 || h.1 < 0.0) && h.0 <= refit_est && refit_est <= h.1)
             && !hanging_val.is_empty()
             && sensor_heldout(&hanging_val, 0.0, refit_est).0 > SENSOR_HELDOUT_GAIN;
@@ -3546,7 +3568,7 @@ pub fn discover(
         // shares: `joined_with_reading`'s `shared`.)
         let reading: Option<(f64, f64, usize, &str)> = if !accepted {
             None
-        } else if effect.reads_hanging_position() {
+        } else if effect.reads_hanging_position() && !centres_follow_the_bob {
             let centres: Vec<f64> = hanging_id.iter().chain(&hanging_val).copied().collect();
             (centres.len() >= 3).then(|| {
                 let (mean, half, _) = per_run_mean(&centres, 0.0);
@@ -3667,6 +3689,11 @@ pub fn discover(
             ),
         };
         let mut row = row;
+        if centres_follow_the_bob && effect.reads_hanging_position() {
+            row.note.push_str(
+                "; the runs' free decays hang by their bobs (each centre about a torque over its m g l, not one angle for every bob): they read a torque the rig carries, not an offset of the reading, and do not measure it",
+            );
+        }
         if let Some((g, n, needed, passes)) = second_look_left_out {
             row.note.push_str(&format!(
                 "; the identify runs left out one at a time (each judged by the models refitted on the others) join the validate runs, short of the bar alone: E_θ fall {:.1} % ± {:.1} %, {} {:.1} %",

@@ -100,6 +100,43 @@ pub(crate) fn hangs_as_an_offset(readings: &[(f64, f64)], t_p: f64, k: f64, phi:
     n * (rss_torque.max(1e-300) / rss_mean.max(1e-300)).ln() > 10.0
 }
 
+/// Whether the runs' free decays (`readings`: each run's m g l, N·m, and the angle its free decay
+/// swings about) hang where a torque the bob balances puts them, rather than at one angle for
+/// every bob: an offset of the reading moves every run's centre alike (beside its own few
+/// counts of zeroing error), while a torque T the rig itself carries tilts a bob of m g l by
+/// about T/(m g l). The line a + c/(m g l) against the mean alone, by the runs' scatter about
+/// each: ΔBIC n ln(RSS_line / RSS_mean) + ln n below −10 (Kass and Raftery's "very strong").
+/// Not with fewer than four readings, or where the bobs' m g l hardly differ (one bob in every
+/// run: the two cannot be told apart). A cable anchored 0.35 rad to one side (a departure: a
+/// spring and a constant torque, 0.25 N·m/rad) hung eight mixed bobs of m g l 1.29 to 3.67 N·m
+/// at 0.064 down to 0.026 rad, about 0.08 N·m over each one's m g l; read as an offset of the
+/// reading, their centres confirmed a 3.8e-2 rad `encoder_offset`, and it was named.
+pub(crate) fn hangs_by_the_bob(readings: &[(f64, f64)]) -> bool {
+    let n = readings.len();
+    if n < 4 {
+        return false;
+    }
+    let nf = n as f64;
+    let x: Vec<f64> = readings.iter().map(|r| 1.0 / r.0).collect();
+    let (mx, mh) = (
+        x.iter().sum::<f64>() / nf,
+        readings.iter().map(|r| r.1).sum::<f64>() / nf,
+    );
+    let sxx: f64 = x.iter().map(|v| (v - mx).powi(2)).sum();
+    // The bobs' 1/(m g l) must spread by more than rounding (one bob: no line to fit).
+    if !(sxx > 1e-6 * nf * mx * mx) {
+        return false;
+    }
+    let sxh: f64 = x
+        .iter()
+        .zip(readings)
+        .map(|(v, r)| (v - mx) * (r.1 - mh))
+        .sum();
+    let rss_mean: f64 = readings.iter().map(|r| (r.1 - mh).powi(2)).sum();
+    let rss_line = (rss_mean - sxh * sxh / sxx).max(0.0);
+    nf * (rss_line.max(1e-300) / rss_mean.max(1e-300)).ln() + nf.ln() < -10.0
+}
+
 /// The identify runs' direct reading of an offset of the angle's reading: each run's free decay
 /// swings about the offset plus that run's own zeroing error (a few counts, rig.md), so the 95 %
 /// interval of their mean from the runs' scatter ([`per_run_mean`]). `None` with fewer than
@@ -583,6 +620,30 @@ mod tests {
 
     /// A k = 1 position torque's rest angle has a closed form, tan θ = −p sin φ / (1 + p cos φ)
     /// (p = T_p / m g l); Newton's agrees, and for k = 3 it solves the balance it states.
+    /// An offset moves every bob's centre alike (beside each run's own zeroing error); a torque
+    /// the bob balances tilts each by its own m g l. Only the second hangs by the bob, and one
+    /// bob in every run tells neither.
+    #[test]
+    fn a_torque_the_bob_balances_hangs_by_the_bob_an_offset_does_not() {
+        let mgl = [1.29, 1.38, 1.60, 1.64, 1.68, 2.70, 2.80, 3.67];
+        // A few counts (1.53 mrad each) of zeroing error, run by run.
+        let zero = [
+            1.5e-3, -3.1e-3, 0.0, 4.6e-3, -1.5e-3, 3.1e-3, -4.6e-3, 1.5e-3,
+        ];
+        let offset: Vec<(f64, f64)> = mgl.iter().zip(zero).map(|(&g, z)| (g, 0.04 + z)).collect();
+        assert!(!hangs_by_the_bob(&offset));
+        let torque: Vec<(f64, f64)> = mgl
+            .iter()
+            .zip(zero)
+            .map(|(&g, z)| (g, (0.08 / g).asin() + z))
+            .collect();
+        assert!(hangs_by_the_bob(&torque));
+        // One bob: the same centres cannot be told apart.
+        let one: Vec<(f64, f64)> = zero.iter().map(|&z| (1.6, 0.05 + z)).collect();
+        assert!(!hangs_by_the_bob(&one));
+        assert!(!hangs_by_the_bob(&torque[..3]));
+    }
+
     #[test]
     fn a_position_torques_rest_angle_balances_gravity() {
         for (mgl, t_p, phi) in [(1.46, 0.0868, -1.59), (3.19, 0.04, -1.0), (1.25, 0.02, 2.5)] {
