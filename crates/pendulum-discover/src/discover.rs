@@ -466,7 +466,7 @@ impl View {
                 .into_iter()
                 .chain(zero_cols.clone())
                 .collect();
-            if let Some(full) = weight_fit(&id_rows, &all, &base_cols) {
+            if let Some(full) = ols(&id_rows, &all).or_else(|| ols(&id_rows, &base_cols)) {
                 let res = full.residuals(&weak);
                 crate::weak::set_weights(&mut weak, &res);
             }
@@ -820,35 +820,6 @@ fn extend(
 /// The largest regressor group (position_torque's k) in the whole-catalogue fit the weights come
 /// from (see [`crate::weak::set_weights`]).
 const WEIGHT_FIT_MAX_GROUP: u32 = 4;
-
-/// The whole catalogue's fit the weights come from: every column of `all` the rows can tell
-/// apart. Where the full fit is singular (a validate view of three runs could not hold the
-/// encoder offset beside their zeroing errors), the base's columns `base_cols` come first and
-/// each other column joins while the fit stays solvable. Falling back to the base's columns
-/// alone left the missing effect's torque in the residuals the weights are read from: on a
-/// drawn design missing a quadratic drag, one slow run's rows were 50 times noisier than their
-/// weights said against the fast runs' (the drag lives where the runs swing fast), which split
-/// the drag's size by run. `None` where even the base cannot be fitted.
-fn weight_fit(rows: &[WeakRow], all: &[usize], base_cols: &[usize]) -> Option<crate::screen::Ols> {
-    if let Some(full) = ols(rows, all) {
-        return Some(full);
-    }
-    let mut kept = base_cols.to_vec();
-    let mut fit = ols(rows, &kept)?;
-    for &c in all {
-        if kept.contains(&c) {
-            continue;
-        }
-        kept.push(c);
-        match ols(rows, &kept) {
-            Some(f) => fit = f,
-            None => {
-                kept.pop();
-            }
-        }
-    }
-    Some(fit)
-}
 
 /// `x` (parameters of `spec`) with the reference model's damping terms (b, a, μ) set to the
 /// screen's joint estimate `fit` where it has them (finite, floored at 0).
@@ -4978,44 +4949,6 @@ mod tests {
         // The spread is the four precise runs' own (their sizes 0.7, 0.85, 1.0 and 1.15 times
         // the named: a standard deviation of 1.68e-3), the noisy run counting for its precision.
         assert!((spread.apart - 1.68e-3).abs() < 4e-4, "{spread:?}");
-    }
-
-    /// The weights' fit keeps every column the rows can tell apart: a column the others repeat
-    /// (here an exact copy) makes the whole fit singular, and the fit falls back to the base's
-    /// columns plus each column that keeps it solvable, not to the base alone, so the missing
-    /// term's torque does not stay in the residuals the weights are read from.
-    #[test]
-    fn a_column_the_rows_cannot_tell_apart_does_not_leave_the_rest_out_of_the_weights_fit() {
-        let ncol = crate::weak::columns().len();
-        let (base, missing, copy, twin) = (0, 2, 5, 6);
-        let mut unit = xorshift_uniform();
-        let mut uniform = move || 2.0 * unit() - 1.0;
-        let rows: Vec<WeakRow> = (0..300)
-            .map(|i| {
-                let mut x = vec![0.0; ncol];
-                x[base] = uniform();
-                x[missing] = uniform();
-                x[copy] = uniform();
-                x[twin] = x[copy];
-                let target = 0.5 * x[base] + 2.0 * x[missing] + 0.01 * uniform();
-                crate::weak::test_row(i % 3, 0.1, x, target)
-            })
-            .collect();
-        let all = [base, missing, copy, twin];
-        assert!(
-            ols(&rows, &all).is_none(),
-            "the copy makes the full fit singular"
-        );
-        let fit = weight_fit(&rows, &all, &[base]).unwrap();
-        assert!(fit.columns.contains(&missing), "{:?}", fit.columns);
-        assert!(!fit.columns.contains(&twin), "{:?}", fit.columns);
-        let rms = |f: &crate::screen::Ols| {
-            let r = f.residuals(&rows);
-            (r.iter().map(|e| e * e).sum::<f64>() / r.len() as f64).sqrt()
-        };
-        // The noise's rms is 0.01/√3; the base alone would leave the missing term's 2/√3.
-        assert!(rms(&fit) < 0.01, "{}", rms(&fit));
-        assert!(rms(&ols(&rows, &[base]).unwrap()) > 0.5);
     }
 
     #[test]
