@@ -1397,33 +1397,25 @@ pub fn discover(
             .collect()
     };
     let (hanging_id, hanging_val) = (hanging_of(Role::Identify), hanging_of(Role::Validate));
-    // The same readings with each run's m g l (N·m), for a torque's rest angles.
-    let hanging_by_bob: Vec<(f64, f64)> = ctx
-        .runs
-        .iter()
-        .filter(|r| r.role == Role::Identify)
-        .filter_map(|r| {
-            let h = ctx.hanging.get(&r.id).copied().flatten()?;
-            let mgl = r.rig.m_kg * r.rig.g_m_s2 * r.rig.l_m;
-            (mgl > 0.0).then_some((mgl, h))
-        })
-        .collect();
-    // Where the free decays hang reads an offset of the reading only where every bob hangs at
-    // one angle ([`hangs_by_the_bob`], asked of every run's centre: a refusal the validate runs
-    // may give): a torque the bob balances tilts each bob by its own m g l, and then the
-    // centres read no offset at all.
-    let centres_follow_the_bob = {
-        let every: Vec<(f64, f64)> = ctx
-            .runs
+    // The same readings with each run's m g l (N·m), of the runs `of` keeps: the identify runs'
+    // for a torque's rest angles, every run's for whether the centres hang by their bobs.
+    let by_bob = |of: &dyn Fn(Role) -> bool| -> Vec<(f64, f64)> {
+        ctx.runs
             .iter()
+            .filter(|r| of(r.role))
             .filter_map(|r| {
                 let h = ctx.hanging.get(&r.id).copied().flatten()?;
                 let mgl = r.rig.m_kg * r.rig.g_m_s2 * r.rig.l_m;
                 (mgl > 0.0).then_some((mgl, h))
             })
-            .collect();
-        hangs_by_the_bob(&every)
+            .collect()
     };
+    let hanging_by_bob = by_bob(&|role| role == Role::Identify);
+    // Where the free decays hang reads an offset of the reading only where every bob hangs at
+    // one angle ([`hangs_by_the_bob`], asked of every run's centre: a refusal the validate runs
+    // may give): a torque the bob balances tilts each bob by its own m g l, and then the
+    // centres read no offset at all.
+    let centres_follow_the_bob = hangs_by_the_bob(&by_bob(&|_| true));
     let hanging_offset = if centres_follow_the_bob {
         None
     } else {
