@@ -2451,7 +2451,8 @@ pub fn discover(
             _ => None,
         };
         // (Against its own noise, as every held-out gain here.)
-        let screen_size_confirmed = at_screen.is_none_or(|(g, n)| g > cfg.gain_min.max(n));
+        let screen_size_confirmed =
+            at_screen.is_none_or(|gn| ThetaFall::new(gn, cfg.gain_min).clears(1.0));
         let size_rests_on_eq_alone = needs_e_theta && !(thf.clears(1.0) && screen_size_confirmed);
         // Unless the view free to describe the torque otherwise takes this effect's own shape:
         // the generic sparse description of what the current model leaves (its library of
@@ -2828,7 +2829,8 @@ pub fn discover(
             } else {
                 None
             };
-            let left_out_passes = left_out.is_some_and(|(g, n)| g > margin * cfg.gain_min.max(n));
+            let left_out_passes =
+                left_out.is_some_and(|gn| ThetaFall::new(gn, cfg.gain_min).clears(margin));
             if let Some((g, n)) = left_out {
                 second_look_left_out = Some((g, n, margin * cfg.gain_min.max(n), left_out_passes));
             }
@@ -4234,13 +4236,19 @@ pub fn discover(
         let tics = followed_ics(&traj, &spec_w, &start, &tics);
         let (x_w, _, _) = refit_zeroed_on(&traj, &spec_w, &start, &tics, cfg.refit_evals);
         let val_w = validate(&held_runs, &spec_w, &x_w, &cfg.validate)?;
-        let (gain, noise) = effect_heldout_gain(
-            effect,
-            &judged_for(effect, &val_w, &free_moving_val),
-            &judged_for(effect, &current_val, &free_moving_val),
-            &held_runs,
+        let ThetaFall {
+            gain,
+            noise,
+            needed,
+        } = ThetaFall::new(
+            effect_heldout_gain(
+                effect,
+                &judged_for(effect, &val_w, &free_moving_val),
+                &judged_for(effect, &current_val, &free_moving_val),
+                &held_runs,
+            ),
+            cfg.gain_min,
         );
-        let needed = cfg.gain_min.max(noise);
         if gain > needed {
             continue;
         }
